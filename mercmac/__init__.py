@@ -1,0 +1,3 @@
+"""mercmac: write, check, simulate and upload macro programs for PI Mercury controllers."""
+
+__version__ = "0.1.0"

@@ -1,0 +1,4 @@
+"""`python -m mercmac`."""
+from mercmac.cli import main
+
+main()

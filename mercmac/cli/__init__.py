@@ -1,0 +1,109 @@
+"""The `mercmac` command: a thin click layer over the importable API (SPEC §5).
+
+Commands parse options and call the library; `run_guarded` is the one place
+that turns exceptions into a message and an exit code.
+"""
+from __future__ import annotations
+
+import click
+
+from mercmac import __version__
+from mercmac.cli.common import MODEL_CHOICE, run_guarded
+from mercmac.errors import EXIT_FAILED, EXIT_OK, UsageError
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="mercmac")
+def main() -> None:
+    """Write, check, simulate and upload stand-alone macro programs for
+    PI Mercury C-663 / C-863 controllers."""
+
+
+@main.command()
+@click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False, allow_dash=True))
+@click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
+              show_default=True, help="Output for people or for programs.")
+def check(files: tuple[str, ...], target: str | None, fmt: str) -> None:
+    """Check .mcm files against the firmware's rules.
+
+    Exit 0 when no errors are found, 1 when there are errors, 2 when a file
+    cannot be read.
+    """
+    def work() -> int:
+        from mercmac.compiler import compile_file
+        from mercmac.render import diagnostics as render
+
+        results = [compile_file(f, target=target) for f in files]
+        found = [d for r in results for d in r.report.items]
+        if fmt == "json":
+            click.echo(render.to_json(found))
+        else:
+            render.write_text(found, {r.source.name: r.source for r in results}, len(results))
+        return EXIT_FAILED if any(r.report.has_errors for r in results) else EXIT_OK
+
+    run_guarded(work)
+
+
+@main.command()
+@click.argument("file", type=click.Path(dir_okay=False, allow_dash=True))
+@click.option("-o", "--output", type=click.Path(dir_okay=False, allow_dash=True),
+              help="Write the MD lines to this file instead of standard output.")
+@click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
+def build(file: str, output: str | None, target: str | None) -> None:
+    """Print the MD lines that go to the controller: slot order, macro 0 last.
+
+    Refuses (exit 1, diagnostics on standard error) when the file has errors.
+    """
+    def work() -> int:
+        from mercmac.compiler import compile_file
+        from mercmac.render import diagnostics as render
+
+        result = compile_file(file, target=target)
+        if result.report.has_errors:
+            render.write_text(result.report.items, {result.source.name: result.source}, 1,
+                              click.get_text_stream("stderr"))
+            return EXIT_FAILED
+        text = "".join(line + "\n" for line in result.program.md_lines())
+        if output and output != "-":
+            try:
+                with open(output, "w", encoding="ascii", newline="\n") as f:
+                    f.write(text)
+            except OSError as e:
+                raise UsageError(f"cannot write {output}: {e.strerror or e}") from None
+        else:
+            click.echo(text, nl=False)
+        return EXIT_OK
+
+    run_guarded(work)
+
+
+@main.command()
+@click.argument("key", required=False)
+def explain(key: str | None) -> None:
+    """Explain a rule by code (MM011) or name (nested-call); list them all without one."""
+    def work() -> int:
+        from mercmac.render.explain import write_explanation, write_rule_list
+
+        if key is None:
+            write_rule_list()
+        else:
+            write_explanation(key)
+        return EXIT_OK
+
+    run_guarded(work)
+
+
+def _register() -> None:
+    """Commands owned by the simulator and the uploader."""
+    from mercmac.cli import sim, upload
+
+    main.add_command(sim.sim)
+    for command in upload.COMMANDS:
+        main.add_command(command)
+
+
+try:
+    _register()
+except ImportError:  # pragma: no cover - during development of those packages
+    pass

@@ -1,0 +1,35 @@
+"""What every command shares: option types and the one exception-to-exit-code place."""
+from __future__ import annotations
+
+import sys
+from typing import Callable
+
+import click
+
+from mercmac.commands import MODELS
+from mercmac.errors import EXIT_INTERRUPTED, EXIT_USAGE, MercmacError
+
+MODEL_CHOICE = click.Choice(MODELS, case_sensitive=False)
+
+
+def run_guarded(work: Callable[[], int]) -> None:
+    """Run a command body; exit with its code, or with a message and no traceback."""
+    try:
+        code = work()
+    except MercmacError as e:
+        _say(e.message, e.hint)
+        code = e.exit_code
+    except KeyboardInterrupt:
+        _say("interrupted")
+        code = EXIT_INTERRUPTED
+    except OSError as e:
+        name = f" {e.filename}" if getattr(e, "filename", None) else ""
+        _say(f"cannot read{name}: {e.strerror or e}")
+        code = EXIT_USAGE
+    sys.exit(code)
+
+
+def _say(message: str, hint: str | None = None) -> None:
+    click.echo(f"mercmac: {message}", err=True)
+    if hint:
+        click.echo(f"  hint: {hint}", err=True)

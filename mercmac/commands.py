@@ -1,0 +1,337 @@
+"""The one command table: every native command of manual MS176E §6.
+
+Everything that needs to know a mnemonic (parser checks, lowering, the VM
+assembler, the uploader, `mercmac explain`) reads this module; nothing else
+lists mnemonics.  Page numbers are those of the manual's §6.2 table.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+C663 = "C-663"
+C863 = "C-863"
+MODELS = (C663, C863)
+BOTH = frozenset(MODELS)
+ONLY_663 = frozenset({C663})
+ONLY_863 = frozenset({C863})
+
+# MS176E §6.4 MA: -1,073,741,824 < n < 1,073,741,823; MR: the resulting target
+# must lie within +/-1,073,741,823.
+MAX_POSITION = 1_073_741_823
+# MS176E §6.1.2: "MR ... a maximum of 9 digits".
+MAX_DISTANCE = 999_999_999
+# MS176E §6.4 JC/JH/JL: soft limits are 32-bit counts.
+MAX_INT32 = 2_147_483_647
+MAX_UINT16 = 65_535
+
+
+class Kind(str, Enum):
+    """What a command does, as far as checks and the VM care."""
+
+    MOTION = "motion"
+    WAIT = "wait"
+    CONDITION = "condition"
+    CALL = "call"
+    REPEAT = "repeat"
+    OUTPUT = "output"
+    SETTING = "setting"
+    REPORT = "report"
+    MACRO = "macro management"
+
+
+class Arg(str, Enum):
+    """Whether a command takes an argument."""
+
+    NONE = "none"
+    REQUIRED = "required"
+    OPTIONAL = "optional"
+
+
+@dataclass(frozen=True, slots=True)
+class Command:
+    """One native command as the manual defines it."""
+
+    mnemonic: str
+    summary: str
+    kind: Kind
+    page: int
+    arg: Arg = Arg.NONE
+    arg_name: str = ""
+    lo: int | None = None
+    hi: int | None = None
+    default: int | None = None  # what the controller substitutes when omitted
+    note_default: bool = False  # omitted argument deserves an info (SPEC §2)
+    models: frozenset = BOTH
+    report: str | None = None  # report identifier, e.g. "P:"
+    storable: bool = True  # may stand in a macro (MS176E §3.8, §6.4 RT)
+
+    @property
+    def section(self) -> str:
+        return f"MS176E §6.4, p. {self.page}"
+
+    def range_text(self) -> str:
+        if self.lo is not None and self.hi is not None:
+            return f"{self.lo}..{self.hi}"
+        if self.lo is not None:
+            return f">= {self.lo:,}"
+        if self.hi is not None:
+            return f"<= {self.hi:,}"
+        return "any integer"
+
+    def in_range(self, value: int) -> bool:
+        return (self.lo is None or value >= self.lo) and (self.hi is None or value <= self.hi)
+
+    def expects(self) -> str:
+        """What the argument should be, as a phrase: 'EM takes a macro number 1-31'."""
+        if self.arg is Arg.NONE:
+            return f"{self.mnemonic} takes no argument"
+        what = self.arg_name or "a number"
+        if self.lo is not None and self.hi is not None and self.hi - self.lo <= 65_535:
+            what = f"{what} {self.lo}-{self.hi}"
+        optional = " (optional)" if self.arg is Arg.OPTIONAL else ""
+        return f"{self.mnemonic} takes {what}{optional}"
+
+    def available_on(self, model: str | None) -> bool:
+        return model is None or model in self.models
+
+
+def _c(mnemonic, summary, kind, page, **kw) -> Command:
+    return Command(mnemonic, summary, kind, page, **kw)
+
+
+_REQ, _OPT = Arg.REQUIRED, Arg.OPTIONAL
+_M, _W, _X, _E, _R = Kind.MOTION, Kind.WAIT, Kind.CONDITION, Kind.CALL, Kind.REPEAT
+_O, _S, _T, _MM = Kind.OUTPUT, Kind.SETTING, Kind.REPORT, Kind.MACRO
+_GAIN = dict(arg=_OPT, arg_name="a gain", lo=0, hi=MAX_UINT16, default=0, note_default=True)
+
+_TABLE = (
+    # -- motion (§3.5, §4.3, §4.4, §6.4) --
+    _c("AB", "Abort motion: AB stops abruptly, AB1 decelerates smoothly", _M, 47,
+       arg=_OPT, arg_name="1 for a smooth stop", lo=1, hi=1),
+    _c("DH", "Define home: the current position becomes n", _M, 50,
+       arg=_OPT, arg_name="a position", lo=-MAX_POSITION, hi=MAX_POSITION, default=0),
+    _c("FE", "Find edge: reference search (0 positive, 1 negative, 2 PI stages, 3 older stages)",
+       _M, 53, arg=_OPT, arg_name="a search mode", lo=0, hi=3, default=0),
+    _c("GH", "Go home: move to position 0 (same as MA0)", _M, 60),
+    _c("MA", "Move absolute to position n", _M, 68,
+       arg=_REQ, arg_name="a target position", lo=-MAX_POSITION, hi=MAX_POSITION),
+    _c("MR", "Move relative by n from the last target", _M, 69,
+       arg=_REQ, arg_name="a distance", lo=-MAX_DISTANCE, hi=MAX_DISTANCE),
+    _c("ST", "Stop motion smoothly and move back to where ST was received", _M, 75),
+    _c("JN", "Joystick on, with maximum velocity n", _M, 65,
+       arg=_REQ, arg_name="a maximum velocity", lo=1000, hi=500_000),
+    _c("JF", "Joystick and trackball off", _M, 65),
+    _c("JA", "Trackball mode on, n counts per signal transition", _M, 62,
+       arg=_REQ, arg_name="an increment", lo=0),
+    _c("MN", "Motor (servo) on", _M, 69),
+    _c("MF", "Motor (servo) off", _M, 69),
+    # -- waits (§6.4) --
+    _c("WA", "Wait n ms from the start of this command", _W, 84,
+       arg=_REQ, arg_name="a time in ms", lo=0, hi=MAX_UINT16),
+    _c("WS", "Wait until the motor is on target, then n ms (default 1000)", _W, 85,
+       arg=_OPT, arg_name="a time in ms", lo=0, hi=MAX_UINT16, default=1000, note_default=True),
+    _c("WN", "Wait until input n is ON", _W, 85, arg=_REQ, arg_name="an input", lo=1, hi=4),
+    _c("WF", "Wait until input n is OFF", _W, 85, arg=_REQ, arg_name="an input", lo=1, hi=4),
+    # -- conditions (§5.5, §6.4 XN/XF): inputs 1-4, 5 joystick, 6 joystick button --
+    _c("XN", "Execute the rest of the line only if input n is ON", _X, 87,
+       arg=_REQ, arg_name="an input", lo=1, hi=6),
+    _c("XF", "Execute the rest of the line only if input n is OFF", _X, 87,
+       arg=_REQ, arg_name="an input", lo=1, hi=6),
+    # -- macro calls and repeats (§3.8, §6.4 EM/RP) --
+    _c("EM", "Execute macro n", _E, 52, arg=_REQ, arg_name="a macro number", lo=1, hi=31),
+    _c("RP", "Repeat the line from its beginning n more times (default 65535)", _R, 70,
+       arg=_OPT, arg_name="a repeat count", lo=0, hi=32_568, default=65_535, note_default=True),
+    # -- outputs (§4.5) --
+    _c("CN", "Output n ON", _O, 48, arg=_REQ, arg_name="an output", lo=1, hi=4),
+    _c("CF", "Output n OFF", _O, 48, arg=_REQ, arg_name="an output", lo=1, hi=4),
+    _c("CP", "Set outputs 1-4 to the bit pattern n (bit 0 = output 1)", _O, 49,
+       arg=_REQ, arg_name="an output pattern", lo=0, hi=15),
+    _c("ZM", "Trigger mode on output 4 (0 off, 1 single, 2 multiple, 3 grid)", _O, 89,
+       arg=_REQ, arg_name="a trigger mode", lo=0, hi=3),
+    _c("ZP", "Trigger position", _O, 89, arg=_REQ, arg_name="a position",
+       lo=-MAX_INT32, hi=MAX_INT32),
+    _c("ZI", "Trigger increment", _O, 88, arg=_REQ, arg_name="an increment",
+       lo=-MAX_INT32, hi=MAX_INT32),
+    # -- settings (§3.4, §4.1, §4.4, §6.4) --
+    _c("SV", "Set velocity (counts or steps per second)", _S, 75,
+       arg=_REQ, arg_name="a velocity", lo=0, hi=MAX_INT32),
+    _c("SA", "Set acceleration and deceleration (counts or steps per second squared)", _S, 71,
+       arg=_REQ, arg_name="an acceleration", lo=0, hi=MAX_INT32),
+    _c("BF", "Brake off (enables the amplifier of .DD/.PD stages)", _S, 48),
+    _c("BN", "Brake on", _S, 48),
+    _c("LF", "Limit switch evaluation off", _S, 67),
+    _c("LN", "Limit switch evaluation on", _S, 67),
+    _c("LH", "Limit switches active high", _S, 67),
+    _c("LL", "Limit switches active low", _S, 67),
+    _c("JC", "Clear soft limits", _S, 63),
+    _c("JH", "Upper soft limit", _S, 64, arg=_REQ, arg_name="a position",
+       lo=-MAX_INT32, hi=MAX_INT32),
+    _c("JL", "Lower soft limit", _S, 64, arg=_REQ, arg_name="a position",
+       lo=-MAX_INT32, hi=MAX_INT32),
+    _c("JB", "Joystick bias added to the joystick reading", _S, 63,
+       arg=_REQ, arg_name="a bias", lo=-255, hi=255),
+    _c("JT", "Load a predefined joystick table (0-3)", _S, 66,
+       arg=_REQ, arg_name="a table number", lo=0, hi=3),
+    _c("SI", "Joystick table index", _S, 73, arg=_REQ, arg_name="a table index", lo=0, hi=255),
+    # §6.4 SJ says -1024..1024, §3.6.2 says 0..1024: accept the wider range.
+    _c("SJ", "Joystick table value at the current index", _S, 73,
+       arg=_REQ, arg_name="a table value", lo=-1024, hi=1024),
+    _c("SC", "Select this controller (autostart macro only)", _S, 72,
+       arg=_REQ, arg_name="an address", lo=0, hi=15),
+    # §6.4 DD says 0 < n < 32,767 in its heading and 0..65,535 in its text.
+    _c("DD", "Derivative gain, position control", _S, 50, models=ONLY_863, **_GAIN),
+    _c("DI", "Integral gain, position control", _S, 50, models=ONLY_863, **_GAIN),
+    _c("DL", "Integral limit, position control", _S, 51, models=ONLY_863, **_GAIN),
+    _c("DP", "Proportional gain, position control", _S, 51, models=ONLY_863, **_GAIN),
+    # §6.4 FA says 0..1024, §4.1.5 says -1000 < n < 1000: accept both.
+    _c("FA", "Force control target", _S, 52, models=ONLY_863,
+       arg=_REQ, arg_name="a force target", lo=-1000, hi=1024),
+    _c("FD", "Derivative gain, force control", _S, 53, models=ONLY_863, **_GAIN),
+    _c("FI", "Integral gain, force control", _S, 54, models=ONLY_863, **_GAIN),
+    _c("FL", "Integral limit, force control", _S, 55, models=ONLY_863, **_GAIN),
+    _c("FP", "Proportional gain, force control", _S, 57, models=ONLY_863, **_GAIN),
+    _c("FM", "Control mode (0 position, 1 force, 2 both)", _S, 55, models=ONLY_863,
+       arg=_REQ, arg_name="a control mode", lo=0, hi=2),
+    _c("FN", "Notch filter frequency in Hz", _S, 56, models=ONLY_863,
+       arg=_REQ, arg_name="a frequency", lo=40, hi=10_000),
+    _c("FO", "Offset of the additional sensor input", _S, 57, models=ONLY_863,
+       arg=_REQ, arg_name="an offset", lo=-2048, hi=2048),
+    _c("FQ", "Notch filter edge times 100", _S, 58, models=ONLY_863,
+       arg=_REQ, arg_name="an edge value", lo=0, hi=MAX_UINT16),
+    _c("FS", "Force sign (0 positive, 1 negative)", _S, 59, models=ONLY_863,
+       arg=_REQ, arg_name="a sign", lo=0, hi=1),
+    _c("FT", "Low-pass filter frequency of the additional sensor in Hz", _S, 59,
+       models=ONLY_863, arg=_REQ, arg_name="a frequency", lo=40, hi=10_000),
+    _c("SB", "Trackball input filter", _S, 72, models=ONLY_863,
+       arg=_REQ, arg_name="a filter count", lo=0, hi=MAX_UINT16),
+    _c("SF", "Encoder input filter", _S, 73, models=ONLY_863,
+       arg=_REQ, arg_name="a filter count", lo=0, hi=255),
+    # §6.4 SM: heading 0 < n < 32,767, text 0 to 2^32.
+    _c("SM", "Maximum following error", _S, 74, models=ONLY_863,
+       arg=_REQ, arg_name="a following error", lo=0, hi=2**32),
+    _c("WT", "Settle time in ms for on-target detection", _S, 86, models=ONLY_863,
+       arg=_REQ, arg_name="a time in ms", lo=0, hi=MAX_UINT16),
+    _c("WW", "Settle window in counts", _S, 86, models=ONLY_863,
+       arg=_REQ, arg_name="a window", lo=0, hi=MAX_UINT16),
+    _c("DC", "Drive current in mA", _S, 49, models=ONLY_663,
+       arg=_REQ, arg_name="a current in mA", lo=0, hi=MAX_UINT16),
+    _c("HC", "Hold current in mA", _S, 61, models=ONLY_663,
+       arg=_REQ, arg_name="a current in mA", lo=0, hi=MAX_UINT16),
+    _c("HT", "Hold time in ms", _S, 62, models=ONLY_663,
+       arg=_REQ, arg_name="a time in ms", lo=0, hi=MAX_UINT16),
+    # -- reports (§5.6, §6.1.3) --
+    _c("CS", "Report checksum (firmware version)", _T, 49, report="C:"),
+    _c("GD", "Report D-term, position control", _T, 60, models=ONLY_863, report="D:"),
+    _c("GI", "Report I-term, position control", _T, 60, models=ONLY_863, report="I:"),
+    _c("GL", "Report I-limit, position control", _T, 61, models=ONLY_863, report="M:"),
+    _c("GP", "Report P-term, position control", _T, 61, models=ONLY_863, report="G:"),
+    _c("TA", "Report analog input n (0 all, 1-4 inputs, 5 joystick, 6 joystick button)",
+       _T, 75, arg=_OPT, arg_name="an analog channel", lo=0, hi=6, default=0, report="An:"),
+    _c("TB", "Report board address", _T, 76, report="B:"),
+    _c("TC", "Report digital input n (0 = all, as a hex digit)", _T, 76,
+       arg=_OPT, arg_name="an input channel", lo=0, hi=4, default=0, report="H0n:"),
+    _c("TD", "Report dynamic target", _T, 77, models=ONLY_863, report="N:"),
+    _c("TE", "Report position error", _T, 77, models=ONLY_863, report="E:"),
+    _c("TF", "Report following error", _T, 77, models=ONLY_863, report="F:"),
+    _c("TI", "Report the current repeat counter", _T, 78, report="X:"),
+    # §6.2 lists "T:" for TL; the examples in §6.1.3 and §6.4 report "L:".
+    _c("TL", "Report programmed acceleration", _T, 78, report="L:"),
+    _c("TP", "Report position", _T, 79, report="P:"),
+    _c("TR", "Report the additional (force) sensor", _T, 79, models=ONLY_863, report="R:"),
+    _c("TS", "Report status", _T, 80, report="S:"),
+    _c("TT", "Report target position", _T, 83, report="T:"),
+    _c("TV", "Report current profile velocity", _T, 83, report="V:"),
+    _c("TY", "Report programmed velocity", _T, 83, report="Y:"),
+    _c("VE", "Report firmware version", _T, 84),
+    _c("TM", "Report macro n, or all but macro 0", _T, 78,
+       arg=_OPT, arg_name="a macro number", lo=0, hi=31, default=0, report="MC"),
+    _c("TZ", "Report macro 0", _T, 84, report="MC"),
+    _c("FA?", "Report force control target", _T, 52, models=ONLY_863, report="FA:"),
+    _c("FD?", "Report force D-term", _T, 53, models=ONLY_863, report="FD:"),
+    _c("FI?", "Report force I-term", _T, 55, models=ONLY_863, report="FI:"),
+    _c("FL?", "Report force I-limit", _T, 55, models=ONLY_863, report="FL:"),
+    _c("FM?", "Report control mode", _T, 56, models=ONLY_863, report="FM:"),
+    _c("FN?", "Report notch filter frequency", _T, 56, models=ONLY_863, report="FN:"),
+    _c("FO?", "Report force sensor offset", _T, 57, models=ONLY_863, report="FO:"),
+    _c("FP?", "Report force P-term", _T, 58, models=ONLY_863, report="FP:"),
+    _c("FQ?", "Report notch filter edge", _T, 58, models=ONLY_863, report="FQ:"),
+    _c("FS?", "Report force sign", _T, 59, models=ONLY_863, report="FS:"),
+    _c("FT?", "Report low-pass filter frequency", _T, 60, models=ONLY_863, report="FT:"),
+    _c("JA?", "Report trackball increment (0 = off)", _T, 63, report="JA:"),
+    _c("JB?", "Report joystick bias", _T, 63, report="JB:"),
+    _c("JH?", "Report upper soft limit", _T, 64, report="JH:"),
+    _c("JL?", "Report lower soft limit", _T, 65, report="JL:"),
+    _c("JN?", "Report joystick velocity (0 = off)", _T, 65, report="JN:"),
+    _c("SB?", "Report trackball filter", _T, 72, models=ONLY_863, report="SB:"),
+    _c("SF?", "Report encoder filter", _T, 73, models=ONLY_863, report="SF:"),
+    _c("SI?", "Report joystick table index", _T, 73, report="I0:"),
+    _c("SJ?", "Report joystick table value", _T, 73, report="SJ:"),
+    _c("SM?", "Report maximum following error", _T, 74, models=ONLY_863, report="SM:"),
+    _c("WT?", "Report settle time", _T, 86, models=ONLY_863, report="WT:"),
+    _c("WW?", "Report settle window", _T, 87, models=ONLY_863, report="WW:"),
+    _c("ZI?", "Report trigger increment", _T, 88, report="ZI:"),
+    _c("ZM?", "Report trigger mode", _T, 89, report="ZM:"),
+    _c("ZP?", "Report trigger position", _T, 90, report="ZP:"),
+    # -- macro management: not storable in a macro (§3.8.5, §6.4 RT) --
+    _c("MD", "Define macro n (the rest of the line is stored)", _MM, 68,
+       arg=_REQ, arg_name="a macro number", lo=0, hi=31, storable=False),
+    _c("RM", "Remove macro n, or all but macro 0", _MM, 70,
+       arg=_OPT, arg_name="a macro number", lo=0, hi=31, storable=False),
+    _c("RMALL", "Remove all macros and reset parameters", _MM, 70, storable=False),
+    _c("RZ", "Remove macro 0", _MM, 71, storable=False),
+    _c("RT", "Reset, as after power-on", _MM, 71, storable=False),
+)
+
+COMMANDS: dict[str, Command] = {c.mnemonic: c for c in _TABLE}
+
+
+@dataclass(frozen=True, slots=True)
+class SingleChar:
+    """A single-character command (MS176E §6.3): sent without CR."""
+
+    char: str
+    equivalent: str | None
+    report: str
+    summary: str
+    models: frozenset = BOTH
+
+
+SINGLE_CHARS: dict[str, SingleChar] = {s.char: s for s in (
+    SingleChar("+", "TE", "E:", "Tell position error", ONLY_863),
+    SingleChar("(", "TF", "F:", "Tell following error", ONLY_863),
+    SingleChar("%", "TS", "S:", "Tell status"),
+    SingleChar("#", "TC", "H00:", "Tell channel"),
+    SingleChar("'", "TP", "P:", "Tell position"),
+    SingleChar("!", "AB", "", "Motor stop"),
+    SingleChar("\\", None, "0 or 1", "Moving status"),
+    SingleChar("/", "TA2", "A2:", "Tell analog 2"),
+    SingleChar("&", "TA1", "A1:", "Tell analog 1"),
+    SingleChar(")", "TA4", "A4:", "Tell analog 4"),
+)}
+
+
+def lookup(mnemonic: str) -> Command | None:
+    """The command for a mnemonic in any case, or None."""
+    return COMMANDS.get(mnemonic.upper())
+
+
+def nearest(word: str) -> str | None:
+    """The known mnemonic closest to an unknown one, for 'did you mean'."""
+    word = word.upper()
+    best, best_cost = None, 3
+    for name in COMMANDS:
+        cost = _distance(word, name)
+        if cost < best_cost or (cost == best_cost and best and name < best):
+            best, best_cost = name, cost
+    return best
+
+
+def _distance(a: str, b: str) -> int:
+    """Levenshtein distance; the words are a few letters long."""
+    row = list(range(len(b) + 1))
+    for i, ca in enumerate(a, 1):
+        prev, row[0] = row[0], i
+        for j, cb in enumerate(b, 1):
+            prev, row[j] = row[j], min(row[j] + 1, row[j - 1] + 1, prev + (ca != cb))
+    return row[-1]

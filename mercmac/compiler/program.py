@@ -1,0 +1,80 @@
+"""The lowered program: slots of base commands, exactly what goes to the controller.
+
+The simulator assembles these, the uploader writes their `MD` lines; both
+show macro names, not numbers, through `Macro.name` and the spans of `Op`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from mercmac.source import Span
+
+MAX_COMMANDS = 16  # MS176E §3.8: "Each macro can contain up to 16 base commands"
+SLOTS = range(32)  # MS176E §3.8.4: macros 0 to 31, 0 = autostart
+
+
+@dataclass(frozen=True, slots=True)
+class Op:
+    """One base command of a lowered macro.
+
+    `mnemonic` is the key of `mercmac.commands.COMMANDS` (upper case, 'FA?'
+    for queries); `arg` is None when omitted. For EM, `role` says why it is
+    there: 'raw' (written natively), 'call', 'goto', 'hoist' (a `when`,
+    `repeat` or `every` body moved into a macro of its own), 'continue' (the
+    tail EM to a macro that continues a split block or the rest of a block).
+    """
+
+    mnemonic: str
+    arg: int | None = None
+    span: Span | None = None
+    role: str = ""
+
+    @property
+    def text(self) -> str:
+        return self.mnemonic if self.arg is None else f"{self.mnemonic}{self.arg}"
+
+
+@dataclass(slots=True)
+class Macro:
+    """One slot's contents, with the name and source span it came from."""
+
+    slot: int
+    name: str
+    ops: list[Op] = field(default_factory=list)
+    span: Span | None = None
+    origin: str = "raw"  # raw, macro, autostart, when, repeat, every, rest, part, stored
+
+    @property
+    def line(self) -> str:
+        """The command line as stored: 'MR5000,WS100'."""
+        return ",".join(op.text for op in self.ops)
+
+    @property
+    def md(self) -> str:
+        """The definition sent to the controller: 'MD5,MR5000,WS100' (MS176E §3.8.1)."""
+        return f"MD{self.slot},{self.line}" if self.ops else f"MD{self.slot}"
+
+    @property
+    def label(self) -> str:
+        """'main (MC05)' for named macros, 'MC05' for raw ones."""
+        tag = f"MC{self.slot:02d}"
+        return tag if self.name == tag else f"{self.name} ({tag})"
+
+
+@dataclass(slots=True)
+class Program:
+    """All macros of one compiled file, by slot."""
+
+    macros: dict[int, Macro]
+    target: str | None = None
+    file: str = ""
+
+    def ordered(self) -> list[Macro]:
+        """Slot order with macro 0 last: the safe upload order (SPEC §4 rule 5)."""
+        return sorted(self.macros.values(), key=lambda m: (m.slot == 0, m.slot))
+
+    def md_lines(self) -> list[str]:
+        return [m.md for m in self.ordered()]
+
+    def names(self) -> dict[int, str]:
+        return {slot: m.name for slot, m in self.macros.items()}

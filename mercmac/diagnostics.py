@@ -1,0 +1,196 @@
+"""Diagnostics are data: the rules of SPEC §2, each with a stable code and its story.
+
+Checks only call `Report.add(rule, span, message)` and carry on; rendering
+lives in `mercmac.render`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import IntEnum
+
+from mercmac.source import Span
+
+
+class Severity(IntEnum):
+    """Ordered so that errors sort first."""
+
+    ERROR = 0
+    WARNING = 1
+    INFO = 2
+
+    def __str__(self) -> str:
+        return self.name.lower()
+
+
+@dataclass(frozen=True, slots=True)
+class Rule:
+    """One check: stable code, kebab-case name, default severity and the long story."""
+
+    code: str
+    name: str
+    severity: Severity
+    summary: str
+    explanation: str
+
+
+_E, _W, _I = Severity.ERROR, Severity.WARNING, Severity.INFO
+
+RULES: tuple[Rule, ...] = (
+    Rule("MM001", "syntax", _E, "the file cannot be parsed", """\
+The parser met something it cannot read. The message points at the offending
+token and says what would have been accepted there; for a native command it
+says what argument the command takes (MS176E §6.4), e.g. "EM takes a macro
+number 1-31" for the placeholder `EMxx` of the manual's Example 3.
+A raw block is `[MCnn] CMD,CMD,...` on one line (MS176E §3.8.6); commands in a
+high-level block are separated by commas or new lines; `goto` may only be the
+last statement of its block. Fix the text at the caret."""),
+    Rule("MM002", "unknown-command", _E, "mnemonic not in the manual's command set", """\
+The controller only knows the base commands of MS176E §6.2. An unknown
+mnemonic in a macro is stored as is and fails silently when the macro runs
+(error 06 "Wrong Command" in the TS report, §6.4 TS). mercmac suggests the
+nearest known mnemonic. Run `mercmac explain` on a rule, or see §6.2 for the
+full list."""),
+    Rule("MM003", "bad-argument", _E, "argument missing where required, or not a number", """\
+Commands such as MA, MR, EM, CN, WA or XN need a number right after the
+mnemonic (MS176E §6.1.2: "MR alone would be useless"). Arguments are decimal
+integers, optionally signed; in high-level blocks a `const` name may stand for
+the number. Commands without an argument (TP, GH, ...) take none."""),
+    Rule("MM004", "argument-range", _E, "argument outside the manual's range", """\
+Each argument has the range MS176E §6.4 gives: MA/MR targets within
++/-1,073,741,823, RP n <= 32568, CN/CF/WN/WF 1-4, XN/XF 1-6 (5 = joystick,
+6 = joystick button), CP 0-15, EM 1-31, SC 0-15, FE 0-3, JT 0-3,
+JN 1000-500000, WA 0-65535, TA 0-6, TC 0-4, ZM 0-3. Out-of-range values are
+refused or misread by the firmware. `repeat N` needs 1 <= N <= 32569 (it
+lowers to RP N-1) and `every T` 0-65535 ms (it lowers to WA T)."""),
+    Rule("MM005", "too-many-commands", _E, "a macro holds more than 16 base commands", """\
+A stored macro holds at most 16 base commands (MS176E §3.8, §3.8.4). The
+controller would cut or refuse a longer line. mercmac splits a long high-level
+block into chained macros reached by a tail EM when that keeps the meaning;
+it cannot when the block repeats itself (RP repeats from the start of the
+macro, so the chain would repeat only its last part), and a raw `[MCnn]` block
+is kept exactly as written. Move part of the work into a macro of its own and
+call it, or shorten the block."""),
+    Rule("MM006", "slot-range", _E, "macro number outside 0-31, or more than 32 macros", """\
+Macros are numbered 0 to 31 (MS176E §3.8.4); macro 0 is the autostart macro.
+A raw block or a pin (`macro NAME @n`) outside 0-31 cannot be stored, and a
+program that needs more than 32 macros after hoisting and splitting does not
+fit the controller. Merge small macros or drop unused ones."""),
+    Rule("MM007", "duplicate-slot", _E, "two blocks define the same slot", """\
+MD gives no warning when it overwrites a macro (MS176E §3.8.1, §3.8.4): of two
+blocks with the same number only the last one would be stored, silently. The
+manual's Example 3 defines MC18 and MC19 twice. Give each block its own number
+(or let mercmac allocate slots with `macro NAME { ... }`), and give each named
+macro its own name."""),
+    Rule("MM008", "sc-outside-autostart", _E, "SC anywhere but macro 0", """\
+SC (select controller) "is only allowed in the Macro 0 (autostart macro)"
+(MS176E §6.4 SC, §3.1.2). Elsewhere it does not select the controller. Move
+SC into `autostart { ... }` / `[MC00]`, outside any `when` or `repeat` block
+(those are hoisted into macros of their own)."""),
+    Rule("MM009", "not-in-macro", _E, "a command that cannot be stored in a macro", """\
+MD, RT, RM, RMALL and RZ manage the macro store itself and are for direct
+mode only (MS176E §3.8.1, §3.8.5, §6.4 RT: "This command can not be used in a
+macro command"). mercmac writes the macros for you: `mercmac flash` sends MD
+and RZ as needed. Remove the command from the macro."""),
+    Rule("MM010", "model-unsupported", _E, "command not available on the target model", """\
+Some commands exist on one model only (MS176E §6.2: dark rows C-863, light
+rows C-663): the PID and force-control commands (DP, DI, DD, DL, F*, GD, GI,
+GL, GP, TE, TF, TD, TR, SB, SF, SM, WT, WW) are C-863 only, the current
+settings DC, HC, HT are C-663 only. Checked when the target is known, from
+`target C-863` in the file or `--target` on the command line."""),
+    Rule("MM011", "nested-call", _W, "a called macro calls on: the caller's remainder never runs", """\
+The controller keeps ONE return point (MS176E §3.8.4): "MC1 could call MC2,
+but MC2 could not then call MC3 and still be able to return to complete the
+remainder of MC1". When macro A continues after `EMb` and b contains an EM,
+b's EM replaces A's return point and the rest of A never runs; Example 3's
+MC18 can no longer return to its own caller. On raw blocks this is a warning
+(it is the manual's way of switching modes, Example 4); on `call` it is an
+error. Use `goto` for a transfer that is not meant to return, make the callee
+call nothing, or restructure so that the rest follows in a macro reached by a
+tail EM."""),
+    Rule("MM012", "undefined-macro", _W, "EM to a slot no block defines", """\
+"If there is no macro defined for the number n, no action will be taken"
+(MS176E §6.4 EM). Example 1's MC13 calls 14-17 without defining them. Define
+the macro in the same file, or make sure it is already stored on the
+controller."""),
+    Rule("MM013", "contradictory-condition", _W, "XNn and XFn on the same input in one macro", """\
+XN and XF end the macro when their input is not ON / not OFF (MS176E §5.5,
+§6.4 XN/XF). Testing the same input both ways in one macro means the commands
+after the second test can only run if the input changed in between - usually
+a typo: Example 2's MC14 says "unless button 1" but tests XF2. Check the input
+numbers."""),
+    Rule("MM014", "default-argument", _I, "argument omitted where the controller substitutes a default", """\
+Some commands take a default when the argument is left out: WS waits 1000 ms
+after the stop (§6.4 WS), a bare RP repeats 65535 times (§6.4 RP), and a gain
+such as `DI,` is set to 0 (Example 1). Write the value to make the intent
+explicit."""),
+    Rule("MM015", "joystick-in-macro", _W, "JN in a macro", """\
+CAUTION (MS176E §3.6.1, §3.8.6): "Do not enable a joystick axis when no
+joystick is connected to the controller hardware. Otherwise the corresponding
+controller axis may start moving." A macro - above all the autostart macro -
+runs with nobody watching. Make sure a calibrated joystick is always
+connected, or enable it from the host instead."""),
+    Rule("MM016", "unreachable-macro", _I, "macro not reachable from macro 0", """\
+No chain of EM commands leads from the autostart macro (macro 0) to this
+macro, so in stand-alone operation it never runs (MS176E §3.8.5). That is
+fine for macros the host starts with EMn. Reported when the program has an
+autostart macro."""),
+    Rule("MM017", "undefined-name", _E, "high-level name (macro or const) not defined", """\
+`call`, `goto` and constant arguments refer to names defined in the same file
+with `macro NAME { ... }` or `const NAME = value`. Names are case-sensitive.
+Define the name or fix its spelling."""),
+    Rule("MM018", "duplicate-name", _E, "a const is defined twice", """\
+Each `const` name may be defined once, so that every use means one value.
+Rename one of them."""),
+)
+
+_BY_KEY = {r.code: r for r in RULES} | {r.name: r for r in RULES}
+
+
+def rule(key: str) -> Rule:
+    """A rule by code or name, case-insensitively; KeyError if unknown."""
+    return _BY_KEY.get(key) or _BY_KEY.get(key.upper()) or _BY_KEY[key.lower()]
+
+
+@dataclass(frozen=True, slots=True)
+class Diagnostic:
+    """One finding at one place."""
+
+    rule: Rule
+    severity: Severity
+    file: str
+    span: Span
+    message: str
+
+    def sort_key(self):
+        return (self.severity, self.file, self.span.line, self.span.column)
+
+    def as_json(self) -> dict:
+        return {
+            "rule": self.rule.name,
+            "code": self.rule.code,
+            "severity": str(self.severity),
+            "file": self.file,
+            "line": self.span.line,
+            "column": self.span.column,
+            "message": self.message,
+        }
+
+
+@dataclass(slots=True)
+class Report:
+    """Collects diagnostics for one file."""
+
+    file: str
+    items: list[Diagnostic] = field(default_factory=list)
+
+    def add(self, name: str, span: Span, message: str, severity: Severity | None = None) -> None:
+        r = rule(name)
+        self.items.append(Diagnostic(r, r.severity if severity is None else severity,
+                                     self.file, span, message))
+
+    @property
+    def has_errors(self) -> bool:
+        return any(d.severity is Severity.ERROR for d in self.items)
+
+    def sorted(self) -> list[Diagnostic]:
+        return sorted(self.items, key=Diagnostic.sort_key)
