@@ -9,7 +9,7 @@ import click
 
 from mercmac import __version__
 from mercmac.cli.common import MODEL_CHOICE, run_guarded
-from mercmac.errors import EXIT_FAILED, EXIT_OK, UsageError
+from mercmac.errors import EXIT_FAILED, EXIT_OK, EXIT_USAGE, UsageError
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -34,12 +34,20 @@ def check(files: tuple[str, ...], target: str | None, fmt: str) -> None:
         from mercmac.compiler import compile_file
         from mercmac.render import diagnostics as render
 
-        results = [compile_file(f, target=target) for f in files]
+        results, unreadable = [], 0
+        for f in files:
+            try:
+                results.append(compile_file(f, target=target))
+            except OSError as e:
+                click.echo(f"mercmac: cannot read {f}: {e.strerror or e}", err=True)
+                unreadable += 1
         found = [d for r in results for d in r.report.items]
         if fmt == "json":
             click.echo(render.to_json(found))
         else:
             render.write_text(found, {r.source.name: r.source for r in results}, len(results))
+        if unreadable:
+            return EXIT_USAGE
         return EXIT_FAILED if any(r.report.has_errors for r in results) else EXIT_OK
 
     run_guarded(work)

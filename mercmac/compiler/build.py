@@ -1,0 +1,97 @@
+"""Parse tree -> AST. The Transformer builds dataclasses with spans and nothing else."""
+from __future__ import annotations
+
+from mercmac.compiler import ast
+from mercmac.compiler.parser_tables import Token, Transformer, v_args
+from mercmac.source import Span
+
+
+def _span(meta) -> Span:
+    return Span(meta.line, meta.column, meta.end_line, meta.end_column)
+
+
+def _tspan(tok: Token) -> Span:
+    return Span(tok.line, tok.column, tok.end_line, tok.end_column)
+
+
+def _int(text: str) -> int:
+    return int(text.replace(" ", "").replace("\t", ""))
+
+
+@v_args(meta=True)
+class _Build(Transformer):
+    def start(self, meta, items):
+        return ast.Module(tuple(items))
+
+    def raw_block(self, meta, children):
+        header, *rest = children
+        digits = header.value.upper().strip("[] \t")[2:]  # "[ MC 05 ]" -> " 05 "
+        return ast.RawBlock(_int(digits), tuple(rest[0]) if rest else (), _span(meta))
+
+    def raw_commands(self, meta, commands):
+        return commands
+
+    def target(self, meta, children):
+        model = children[0].value.upper()
+        return ast.Target(model if "-" in model else f"{model[0]}-{model[1:]}", _span(meta))
+
+    def const(self, meta, children):
+        name, value = children
+        return ast.Const(name.value, _int(value.value), _span(meta))
+
+    def macro(self, meta, children):
+        name, *rest = children
+        pin = rest[0] if len(rest) == 2 else None
+        return ast.MacroDef(name.value, pin, rest[-1], _span(meta))
+
+    def pin(self, meta, children):
+        return ast.Number(_int(children[0].value), _tspan(children[0]))
+
+    def autostart(self, meta, children):
+        return ast.Autostart(children[0], _span(meta))
+
+    def block(self, meta, stmts):
+        return tuple(stmts)
+
+    def call(self, meta, children):
+        return ast.Call(children[0].value, _span(meta))
+
+    def goto(self, meta, children):
+        return ast.Goto(children[0].value, _span(meta))
+
+    def when(self, meta, children):
+        *conditions, body = children
+        return ast.When(tuple(conditions), body, _span(meta))
+
+    def condition(self, meta, children):
+        return ast.Condition(children[-1], len(children) == 2, _span(meta))
+
+    def repeat(self, meta, children):
+        return ast.Repeat(children[0], children[1], _span(meta))
+
+    def every(self, meta, children):
+        return ast.Every(children[0], children[1], _span(meta))
+
+    def period(self, meta, children):
+        tok = children[0]
+        if tok.type == "NAME":
+            return ast.Name(tok.value, _tspan(tok))
+        from mercmac.timespec import parse_duration
+
+        return ast.Number(parse_duration(tok.value), _tspan(tok))
+
+    def command(self, meta, children):
+        word = children[0]
+        value = children[1] if len(children) > 1 else None
+        return ast.Command(word.value, value, _span(meta), _tspan(word))
+
+    def value(self, meta, children):
+        tok = children[0]
+        if tok.type == "INT":
+            return ast.Number(_int(tok.value), _tspan(tok))
+        return ast.Name(tok.value, _tspan(tok))
+
+
+def build(tree) -> ast.Module:
+    """The AST of a parse tree."""
+    return _Build().transform(tree)

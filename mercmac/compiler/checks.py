@@ -1,0 +1,196 @@
+"""Checks on the syntax tree: commands, arguments, names and slots (SPEC §2).
+
+The pass also resolves what lowering needs: each valid native command as an
+`Op`, each `const`, each named macro. Checks only report and carry on.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from mercmac.commands import MODELS, Arg, lookup, nearest
+from mercmac.compiler import ast
+from mercmac.compiler.program import SLOTS, Op
+from mercmac.diagnostics import Report
+from mercmac.source import Span
+
+MAX_REPEAT = 32_568 + 1  # `repeat N` lowers to RP N-1; MS176E §6.4 RP: n <= 32568
+MAX_PERIOD_MS = 65_535  # `every T` lowers to WA T; MS176E §6.4 WA
+INPUTS = range(1, 7)  # XN/XF: 1-4 inputs, 5 joystick, 6 joystick button (§6.4 XN)
+
+
+@dataclass
+class Env:
+    """What the checks resolved, for lowering."""
+
+    target: str | None = None
+    consts: dict[str, int] = field(default_factory=dict)
+    macros: dict[str, ast.MacroDef] = field(default_factory=dict)
+    ops: dict[ast.Command, Op] = field(default_factory=dict)
+    values: dict[ast.Value, int] = field(default_factory=dict)
+
+
+def check_module(module: ast.Module, report: Report, target: str | None) -> Env:
+    """Report every AST-level problem; return the resolved environment."""
+    env = Env(target=target)
+    _declarations(module, report, env)
+    slots: dict[int, Span] = {}
+    for item in module.items:
+        if isinstance(item, ast.RawBlock):
+            _claim_slot(item.slot, item.span, f"MC{item.slot:02d}", slots, report)
+            for command in item.commands:
+                _command(command, env, report, raw=True)
+        elif isinstance(item, ast.Autostart):
+            _claim_slot(0, item.span, "the autostart macro (macro 0)", slots, report)
+            _block(item.body, env, report)
+        elif isinstance(item, ast.MacroDef):
+            if item.pin is not None:
+                _claim_slot(item.pin.value, item.pin.span, f"macro {item.pin.value}", slots, report)
+            _block(item.body, env, report)
+    return env
+
+
+def _declarations(module: ast.Module, report: Report, env: Env) -> None:
+    targets = [i for i in module.items if isinstance(i, ast.Target)]
+    for t in targets:
+        if t.model not in MODELS:
+            report.add("bad-argument", t.span, f"unknown model '{t.model}': use C-663 or C-863")
+    if env.target is None and targets and targets[-1].model in MODELS:
+        env.target = targets[-1].model
+    for item in module.items:
+        if isinstance(item, ast.Const):
+            if item.name in env.consts:
+                report.add("duplicate-name", item.span, f"const '{item.name}' is defined twice")
+            env.consts[item.name] = item.value
+        elif isinstance(item, ast.MacroDef):
+            first = env.macros.get(item.name)
+            if first is not None:
+                report.add("duplicate-slot", item.span,
+                           f"macro '{item.name}' is defined twice (first at line {first.span.line})")
+            else:
+                env.macros[item.name] = item
+
+
+def _claim_slot(slot: int, span: Span, what: str, slots: dict[int, Span], report: Report) -> None:
+    if slot not in SLOTS:
+        report.add("slot-range", span, f"macro number {slot} is outside 0-31")
+    elif slot in slots:
+        report.add("duplicate-slot", span,
+                   f"{what} defines slot {slot} again (first at line {slots[slot].line}); "
+                   "the controller silently keeps only the last definition")
+    else:
+        slots[slot] = span
+
+
+def _block(body: tuple, env: Env, report: Report) -> None:
+    for i, stmt in enumerate(body):
+        if isinstance(stmt, ast.Command):
+            _command(stmt, env, report, raw=False)
+        elif isinstance(stmt, (ast.Call, ast.Goto)):
+            _macro_name(stmt.name, stmt.span, env, report)
+            if isinstance(stmt, ast.Goto) and i != len(body) - 1:
+                report.add("syntax", stmt.span,
+                           "goto transfers for good, so it must be the last statement of its block")
+        elif isinstance(stmt, ast.When):
+            for c in stmt.conditions:
+                _bounded(c.value, env, report, INPUTS,
+                         "when takes inputs 1-6 (1-4 buttons, 5 joystick, 6 joystick button)")
+            _block(stmt.body, env, report)
+        elif isinstance(stmt, ast.Repeat):
+            _bounded(stmt.count, env, report, range(1, MAX_REPEAT + 1),
+                     f"repeat takes a count 1-{MAX_REPEAT} (it lowers to RP n-1, RP n <= 32568)")
+            _block(stmt.body, env, report)
+        elif isinstance(stmt, ast.Every):
+            _bounded(stmt.period, env, report, range(0, MAX_PERIOD_MS + 1),
+                     f"every takes a whole period of 0-{MAX_PERIOD_MS} ms (it lowers to WA)")
+            _block(stmt.body, env, report)
+
+
+def _macro_name(name: str, span: Span, env: Env, report: Report) -> None:
+    if name not in env.macros:
+        hint = _suggest(name, env.macros)
+        report.add("undefined-name", span, f"no macro named '{name}'{hint}")
+
+
+def _suggest(name: str, known) -> str:
+    close = [k for k in known if k.lower() == name.lower()] or [
+        k for k in known if k.lower().startswith(name.lower()[:3])]
+    return f"; did you mean '{close[0]}'?" if close else ""
+
+
+def _bounded(value: ast.Value, env: Env, report: Report, allowed: range, expects: str) -> None:
+    number = _resolve(value, env, report)
+    if number is not None and number not in allowed:
+        report.add("argument-range", value.span, f"{number} is out of range: {expects}")
+
+
+def _resolve(value: ast.Value, env: Env, report: Report) -> int | None:
+    if isinstance(value, ast.Number):
+        env.values[value] = value.value
+        return value.value
+    if value.name not in env.consts:
+        report.add("undefined-name", value.span,
+                   f"no const named '{value.name}'{_suggest(value.name, env.consts)}")
+        return None
+    env.values[value] = env.consts[value.name]
+    return env.consts[value.name]
+
+
+def _command(cmd: ast.Command, env: Env, report: Report, *, raw: bool) -> None:
+    """Validate one native command; record its Op when it is valid."""
+    spec = lookup(cmd.word)
+    if spec is None:
+        _unknown(cmd, report)
+        return
+    arg = None
+    if cmd.value is not None:
+        if spec.arg is Arg.NONE:
+            report.add("bad-argument", cmd.value.span, f"{spec.expects()}")
+            return
+        if raw and isinstance(cmd.value, ast.Name):
+            report.add("syntax", cmd.value.span,
+                       f"{spec.expects()}, found '{cmd.value.name}' (names are for high-level blocks)")
+            return
+        arg = _resolve(cmd.value, env, report)
+        if arg is None:
+            return
+        if not spec.in_range(arg):
+            report.add("argument-range", cmd.value.span,
+                       f"{spec.mnemonic}{arg} is out of range: {spec.expects()} "
+                       f"({spec.range_text()})")
+            return
+    elif spec.arg is Arg.REQUIRED:
+        report.add("bad-argument", cmd.span, f"{spec.expects()}: the argument is missing")
+        return
+    elif spec.note_default:
+        report.add("default-argument", cmd.span,
+                   f"{spec.mnemonic} without an argument: the controller uses {spec.default}")
+    _command_rules(spec, cmd, env, report)
+    env.ops[cmd] = Op(spec.mnemonic, arg, cmd.span, "raw" if spec.mnemonic == "EM" else "")
+
+
+def _command_rules(spec, cmd: ast.Command, env: Env, report: Report) -> None:
+    if not spec.storable:
+        report.add("not-in-macro", cmd.span,
+                   f"{spec.mnemonic} cannot be stored in a macro ({spec.section})")
+    if not spec.available_on(env.target):
+        only = " and ".join(sorted(spec.models))
+        report.add("model-unsupported", cmd.span,
+                   f"{spec.mnemonic} is not available on the {env.target} ({only} only)")
+    if spec.mnemonic == "JN":
+        report.add("joystick-in-macro", cmd.span,
+                   "JN enables the joystick from a macro: the axis may move if no joystick "
+                   "is connected (MS176E §3.6.1 caution)")
+
+
+def _unknown(cmd: ast.Command, report: Report) -> None:
+    """`EMxx` is EM with a bad argument; `XY5` or `RMAL` is an unknown command."""
+    word = cmd.word
+    guess = nearest(word)
+    spec = lookup(word[:2])
+    if spec is not None and not (guess and len(guess) > 2):
+        s = cmd.word_span
+        report.add("syntax", Span(s.line, s.column + 2, s.end_line, s.end_column),
+                   f"{spec.expects()}, found '{word[2:]}'")
+        return
+    hint = f"; did you mean {guess}?" if guess else ""
+    report.add("unknown-command", cmd.word_span, f"unknown command '{word}'{hint}")

@@ -1,0 +1,120 @@
+"""Checks on the lowered program, where the firmware's rules really apply (SPEC §2, §3).
+
+Run on what will be uploaded, so hoisting and splitting are checked too:
+the one return point, EM to empty slots, reachability, SC placement,
+contradictory conditions, the 16-command limit and goto placement.
+"""
+from __future__ import annotations
+
+from mercmac.compiler.program import MAX_COMMANDS, Macro, Op, Program
+from mercmac.diagnostics import Report, Severity
+
+_CONDITIONS = ("XN", "XF")
+_USER_ORIGINS = ("raw", "macro", "autostart")
+
+
+def check_program(program: Program, report: Report) -> None:
+    """Report every rule that needs the lowered program."""
+    for m in program.macros.values():
+        _length(m, report)
+        _placement(m, report)
+        _contradictions(m, report)
+        for i, op in enumerate(m.ops):
+            if op.mnemonic == "EM":
+                _call(program, m, i, op, report)
+    _reachability(program, report)
+
+
+def _length(m: Macro, report: Report) -> None:
+    if m.origin == "raw" and len(m.ops) > MAX_COMMANDS:
+        report.add("too-many-commands", m.span,
+                   f"{m.label} holds {len(m.ops)} commands; a macro holds at most {MAX_COMMANDS} "
+                   "(MS176E §3.8)")
+
+
+def _placement(m: Macro, report: Report) -> None:
+    for i, op in enumerate(m.ops):
+        if op.mnemonic == "SC" and m.slot != 0:
+            where = "" if m.origin in _USER_ORIGINS else f" (this block was moved into {m.label})"
+            report.add("sc-outside-autostart", op.span or m.span,
+                       f"SC is only allowed in macro 0, the autostart macro{where}")
+        if op.role == "goto" and i != len(m.ops) - 1:
+            report.add("syntax", op.span or m.span,
+                       "this goto would come back into the loop around it: goto must end its "
+                       "macro, so it cannot stand directly in a repeat or every block "
+                       "(wrap it in a when block)")
+
+
+def _contradictions(m: Macro, report: Report) -> None:
+    seen: dict[tuple[str, int], Op] = {}
+    for op in m.ops:
+        if op.mnemonic not in _CONDITIONS:
+            continue
+        other = seen.get(("XF" if op.mnemonic == "XN" else "XN", op.arg))
+        if other is not None:
+            report.add("contradictory-condition", op.span or m.span,
+                       f"{m.label} tests input {op.arg} with both {other.text} and {op.text}: "
+                       "the rest can only run if the input changed in between")
+        seen.setdefault((op.mnemonic, op.arg), op)
+
+
+def _call(program: Program, caller: Macro, index: int, op: Op, report: Report) -> None:
+    callee = program.macros.get(op.arg)
+    if callee is None:
+        report.add("undefined-macro", op.span or caller.span,
+                   f"EM{op.arg}: no macro {op.arg} is defined here, so the controller does "
+                   "nothing (unless the macro is already stored on it)")
+        return
+    remainder = caller.ops[index + 1:]
+    if not remainder or _returns(program, callee, remainder):
+        return
+    inner = next(o for o in callee.ops if o.mnemonic == "EM" and o.arg in program.macros)
+    inner_name = program.macros[inner.arg].label
+    rest = ",".join(o.text for o in remainder)
+    message = (f"{caller.label} calls {callee.label} and continues ({rest}), but "
+               f"{callee.label} calls {inner_name}: the controller keeps one return point "
+               f"(MS176E §3.8.4), so the rest of {caller.label} never runs after that")
+    if op.role == "raw":
+        report.add("nested-call", op.span or caller.span, message, Severity.WARNING)
+    else:
+        report.add("nested-call", op.span or caller.span,
+                   message + _advice(op, callee), Severity.ERROR)
+
+
+def _returns(program: Program, callee: Macro, remainder: list[Op]) -> bool:
+    """Whether calling `callee` still lets the caller finish its line as written."""
+    # An EM to an empty slot does nothing (MS176E §6.4 EM), so it keeps the return point.
+    ems = [i for i, o in enumerate(callee.ops) if o.mnemonic == "EM" and o.arg in program.macros]
+    if not ems:
+        return True
+    if any(o.mnemonic in _CONDITIONS for o in callee.ops[ems[0]:]):
+        return False  # an XN/XF after an inner call ends the program, not the callee
+    last = callee.ops[-1]
+    if last.role == "goto":
+        return True  # a mode switch: the caller's rest is abandoned on purpose
+    continues = len(remainder) == 1 and remainder[0].mnemonic == "EM"
+    return continues and last.mnemonic == "EM" and last.arg == remainder[0].arg
+
+
+def _advice(op: Op, callee: Macro) -> str:
+    if op.role == "call":
+        return (". Use `goto` if the caller need not continue, or make the called macro call "
+                "nothing (a split or hoisted block calls on too)")
+    return (". Inside a repeat or every loop a when block may run commands or end in a goto, "
+            "but not call macros; move those commands into the block")
+
+
+def _reachability(program: Program, report: Report) -> None:
+    if 0 not in program.macros:
+        return
+    seen, todo = {0}, [0]
+    while todo:
+        for op in program.macros[todo.pop()].ops:
+            if op.mnemonic == "EM" and op.arg in program.macros and op.arg not in seen:
+                seen.add(op.arg)
+                todo.append(op.arg)
+    for m in program.macros.values():
+        if m.slot not in seen and m.origin in _USER_ORIGINS:
+            report.add("unreachable-macro", m.span,
+                       f"{m.label} is not reached from the autostart macro; it runs only when "
+                       "the host starts it")

@@ -1,0 +1,202 @@
+"""AST -> Program: the high-level constructs as plain macros (SPEC §1).
+
+- `when` blocks become an XN/XF prefix; the block moves into a macro of its
+  own, called with EM, unless it already ends its macro.
+- `repeat N` becomes `...,RP N-1` and `every T` `...,WA T,RP,RP`, hoisted into
+  a macro of their own unless they are the whole macro (RP repeats the line).
+- Where a hoisted block calls out, the code after it would need a second
+  return point (MS176E §3.8.4): that rest moves into a macro of its own that
+  both the block and its caller reach by a tail EM.
+- Blocks over 16 commands are chained through a tail EM when no RP needs the
+  whole line; slots are allocated around raw blocks and pins.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from mercmac.compiler import ast
+from mercmac.compiler.checks import Env
+from mercmac.compiler.program import MAX_COMMANDS, SLOTS, Macro, Op, Program
+from mercmac.diagnostics import Report
+from mercmac.source import Span
+
+
+@dataclass(eq=False)
+class _Macro:
+    """A macro being lowered: its EM targets may not have slots yet."""
+
+    name: str
+    origin: str
+    span: Span
+    slot: int | None = None
+    ops: list = field(default_factory=list)  # Op, or _Em before allocation
+
+
+@dataclass(frozen=True, eq=False)
+class _Em:
+    target: _Macro
+    span: Span
+    role: str
+
+
+def _calls_on(ops: list) -> bool:
+    """True when a block would lose its caller's return point and not end in a goto."""
+    ems = [op for op in ops if _is_em(op)]
+    return bool(ems) and any(e.role != "goto" for e in ems) and not (
+        _is_em(ops[-1]) and ops[-1].role == "goto")
+
+
+def _is_em(op) -> bool:
+    return isinstance(op, _Em) or (isinstance(op, Op) and op.mnemonic == "EM")
+
+
+class _Lowerer:
+    def __init__(self, env: Env, report: Report):
+        self.env, self.report = env, report
+        self.order: list[_Macro] = []
+        self.named: dict[str, _Macro] = {}
+
+    def new(self, name: str, origin: str, span: Span, slot: int | None = None) -> _Macro:
+        m = _Macro(name, origin, span, slot)
+        self.order.append(m)
+        return m
+
+    def helper(self, owner: _Macro, kind: str, span: Span) -> _Macro:
+        return self.new(f"{owner.name}.{kind}@{span.line}", kind, span)
+
+    # -- statements --------------------------------------------------------
+    def seq(self, stmts: tuple, owner: _Macro, *, at_start: bool, loop: bool) -> list:
+        """The ops of a statement sequence that runs to the end of `owner`'s line
+        (or, inside a repeat/every body, up to the loop's RP)."""
+        out: list = []
+        for i, stmt in enumerate(stmts):
+            rest = stmts[i + 1:]
+            whole = at_start and not out and not rest and not loop
+            if isinstance(stmt, ast.Command):
+                if stmt in self.env.ops:
+                    out.append(self.env.ops[stmt])
+            elif isinstance(stmt, (ast.Call, ast.Goto)):
+                target = self.named.get(stmt.name)
+                if target is not None:
+                    out.append(_Em(target, stmt.span, "call" if isinstance(stmt, ast.Call) else "goto"))
+            elif isinstance(stmt, ast.Repeat) and self.value(stmt.count) == 1:
+                return out + self.seq(stmt.body + rest, owner, at_start=whole, loop=loop)
+            elif isinstance(stmt, ast.When) and not rest and not loop:
+                return out + self.conditions(stmt) + self.seq(stmt.body, owner, at_start=False, loop=False)
+            elif isinstance(stmt, (ast.Repeat, ast.Every)) and whole:
+                return out + self.loop_ops(stmt, owner)
+            else:
+                block = self.hoist(stmt, owner)
+                out.append(_Em(block, stmt.span, "hoist"))
+                if rest and not loop and _calls_on(block.ops):
+                    after = self.helper(owner, "rest", rest[0].span)
+                    after.ops = self.seq(rest, after, at_start=True, loop=False)
+                    block.ops.append(_Em(after, rest[0].span, "continue"))
+                    out.append(_Em(after, rest[0].span, "continue"))
+                    return out
+        return out
+
+    def hoist(self, stmt, owner: _Macro) -> _Macro:
+        """A when/repeat/every block in a macro of its own."""
+        kind = type(stmt).__name__.lower()
+        block = self.helper(owner, kind, stmt.span)
+        if isinstance(stmt, ast.When):
+            block.ops = self.conditions(stmt) + self.seq(stmt.body, block, at_start=False, loop=False)
+        else:
+            block.ops = self.loop_ops(stmt, block)
+        return block
+
+    def loop_ops(self, stmt, owner: _Macro) -> list:
+        body = self.seq(stmt.body, owner, at_start=False, loop=True)
+        if isinstance(stmt, ast.Repeat):
+            return body + [Op("RP", self.value(stmt.count) - 1, stmt.span)]
+        # every T: wait T, then RP,RP = 65536 x 65536 passes, "forever" (§3.8.6 Example 1)
+        return body + [Op("WA", self.value(stmt.period), stmt.span),
+                       Op("RP", None, stmt.span), Op("RP", None, stmt.span)]
+
+    def conditions(self, stmt: ast.When) -> list:
+        return [Op("XF" if c.negated else "XN", self.value(c.value), c.span)
+                for c in stmt.conditions if self.value(c.value) is not None]
+
+    def value(self, v: ast.Value) -> int | None:
+        return self.env.values.get(v)
+
+    # -- items -------------------------------------------------------------
+    def module(self, module: ast.Module) -> None:
+        for item in module.items:
+            if isinstance(item, ast.MacroDef) and self.env.macros.get(item.name) is item:
+                pin = item.pin.value if item.pin is not None and item.pin.value in SLOTS else None
+                self.named[item.name] = self.new(item.name, "macro", item.span, pin)
+        for item in module.items:
+            if isinstance(item, ast.RawBlock):
+                m = self.new(f"MC{item.slot:02d}", "raw", item.span, item.slot)
+                m.ops = [self.env.ops[c] for c in item.commands if c in self.env.ops]
+            elif isinstance(item, ast.Autostart):
+                m = self.new("autostart", "autostart", item.span, 0)
+                m.ops = self.seq(item.body, m, at_start=True, loop=False)
+            elif isinstance(item, ast.MacroDef) and item.name in self.named:
+                m = self.named[item.name]
+                if self.env.macros[item.name] is item:
+                    m.ops = self.seq(item.body, m, at_start=True, loop=False)
+
+    def split(self) -> None:
+        """Chain lowered macros over 16 commands through a tail EM (MS176E §3.8)."""
+        for m in list(self.order):
+            part = m
+            while m.origin != "raw" and len(part.ops) > MAX_COMMANDS:
+                if any(isinstance(op, Op) and op.mnemonic == "RP" for op in part.ops):
+                    self.report.add("too-many-commands", m.span,
+                                    f"'{m.name}' needs {len(part.ops)} commands, a macro holds "
+                                    f"{MAX_COMMANDS}, and it cannot be split: its RP repeats the "
+                                    "whole line. Move part of the body into a macro and call it")
+                    break
+                tail = self.new(f"{m.name}.part{_part_number(part)}", "part", m.span)
+                keep = MAX_COMMANDS - 1
+                tail.ops, part.ops = part.ops[keep:], part.ops[:keep]
+                part.ops.append(_Em(tail, _span_of(tail.ops[0], m.span), "continue"))
+                part = tail
+
+    def allocate(self) -> dict[int, _Macro]:
+        taken: dict[int, _Macro] = {}
+        for m in self.order:
+            if m.slot is not None:
+                taken[m.slot] = m  # duplicates were reported; the last wins as on the controller
+        free = (s for s in SLOTS if s not in taken)
+        for m in self.order:
+            if m.slot is None:
+                m.slot = next(free, None)
+                if m.slot is None:
+                    self.report.add("slot-range", m.span,
+                                    f"no free slot for '{m.name}': the program needs "
+                                    f"{len(self.order)} macros and the controller holds 32")
+                    continue
+                taken[m.slot] = m
+        return taken
+
+
+def _part_number(m: _Macro) -> int:
+    head, _, n = m.name.rpartition(".part")
+    return int(n) + 1 if head and n.isdigit() else 2
+
+
+def _span_of(op, default: Span) -> Span:
+    return op.span or default
+
+
+def _final(op) -> Op:
+    if isinstance(op, _Em):
+        return Op("EM", op.target.slot, op.span, op.role)
+    return op
+
+
+def lower(module: ast.Module, env: Env, report: Report, file: str = "") -> Program:
+    """The program a module stands for (errors are reported, never raised)."""
+    lowerer = _Lowerer(env, report)
+    lowerer.module(module)
+    lowerer.split()
+    slots = lowerer.allocate()
+    macros = {
+        slot: Macro(slot, m.name, [_final(op) for op in m.ops], m.span, m.origin)
+        for slot, m in sorted(slots.items())
+    }
+    return Program(macros, env.target, file)
