@@ -139,8 +139,10 @@ autostart macro."""),
 with `macro NAME { ... }` or `const NAME = value`. Names are case-sensitive.
 Define the name or fix its spelling."""),
     Rule("MM018", "duplicate-name", _E, "a const is defined twice", """\
-Each `const` name may be defined once, so that every use means one value.
-Rename one of them."""),
+Each `const` name may be defined once, so that every use of the name means
+one value wherever it stands (a second definition would silently change the
+numbers sent to the controller above or below it). Rename one of them, or
+remove the duplicate."""),
 )
 
 _BY_KEY = {r.code: r for r in RULES} | {r.name: r for r in RULES}

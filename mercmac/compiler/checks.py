@@ -183,14 +183,15 @@ def _command_rules(spec, cmd: ast.Command, env: Env, report: Report) -> None:
 
 
 def _unknown(cmd: ast.Command, report: Report) -> None:
-    """`EMxx` is EM with a bad argument; `XY5` or `RMAL` is an unknown command."""
+    """`EMxx` is EM with a placeholder for its argument; `FOO5` is an unknown command."""
     word = cmd.word
-    guess = nearest(word)
     spec = lookup(word[:2])
-    if spec is not None and not (guess and len(guess) > 2):
+    # The manual writes arguments as placeholders: EMxx (Example 3), EMn, MDn,xxx (§3.8.5).
+    if spec is not None and len(word) > 2 and set(word[2:].lower()) <= {"x", "n"}:
         s = cmd.word_span
         report.add("syntax", Span(s.line, s.column + 2, s.end_line, s.end_column),
-                   f"{spec.expects()}, found '{word[2:]}'")
+                   f"{spec.expects()}, found the placeholder '{word[2:]}'")
         return
+    guess = nearest(word)
     hint = f"; did you mean {guess}?" if guess else ""
     report.add("unknown-command", cmd.word_span, f"unknown command '{word}'{hint}")

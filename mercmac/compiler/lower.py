@@ -79,7 +79,7 @@ class _Lowerer:
                 target = self.named.get(stmt.name)
                 if target is not None:
                     out.append(_Em(target, stmt.span, "call" if isinstance(stmt, ast.Call) else "goto"))
-            elif isinstance(stmt, ast.Repeat) and self.value(stmt.count) == 1:
+            elif isinstance(stmt, ast.Repeat) and self.count(stmt) == 1:
                 return out + self.seq(stmt.body + rest, owner, at_start=whole, loop=loop)
             elif isinstance(stmt, ast.When) and not rest and not loop:
                 return out + self.conditions(stmt) + self.seq(stmt.body, owner, at_start=False, loop=False)
@@ -109,14 +109,19 @@ class _Lowerer:
     def loop_ops(self, stmt, owner: _Macro) -> list:
         body = self.seq(stmt.body, owner, at_start=False, loop=True)
         if isinstance(stmt, ast.Repeat):
-            return body + [Op("RP", self.value(stmt.count) - 1, stmt.span)]
+            return body + [Op("RP", self.count(stmt) - 1, stmt.span)]
         # every T: wait T, then RP,RP = 65536 x 65536 passes, "forever" (§3.8.6 Example 1)
-        return body + [Op("WA", self.value(stmt.period), stmt.span),
+        return body + [Op("WA", self.value(stmt.period) or 0, stmt.span),
                        Op("RP", None, stmt.span), Op("RP", None, stmt.span)]
 
     def conditions(self, stmt: ast.When) -> list:
         return [Op("XF" if c.negated else "XN", self.value(c.value), c.span)
                 for c in stmt.conditions if self.value(c.value) is not None]
+
+    def count(self, stmt: ast.Repeat) -> int:
+        """The repeat count; an invalid one (already reported) counts as 1."""
+        count = self.value(stmt.count)
+        return count if count and count > 0 else 1
 
     def value(self, v: ast.Value) -> int | None:
         return self.env.values.get(v)
