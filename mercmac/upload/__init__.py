@@ -1,0 +1,14 @@
+"""The uploader: flash, pull and scan Mercury controllers over a serial link (SPEC §4).
+
+Layers, each with its own error type that the next one up rewords
+(STYLE practice 7):
+
+    protocol.py    bytes: address codes, CR framing, report parsing  -> ProtocolError
+    transport.py   pyserial with a timeout on every read             -> TransportError
+    controller.py  commands to one controller: VE, TM, TZ, MD, RM     -> ControllerError
+    session.py, plan.py, flasher.py, backup.py, survey.py            -> errors.UploadError
+    mercmac/cli/upload.py                                            the click commands
+
+emulator.py and ptyserver.py are the virtual controller behind `mercmac emulate`
+and the tests.
+"""

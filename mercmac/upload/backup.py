@@ -1,0 +1,77 @@
+"""What a controller holds, as a `.mcm` file: the flash backup and `mercmac pull`.
+
+The file is MMCRun's format (MS176E §3.8.6, Example 4) with a `target`
+line, so `mercmac check` accepts it and `mercmac flash` puts back exactly
+these macros.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import os
+import re
+import tempfile
+from pathlib import Path
+
+from mercmac import __version__
+from mercmac.upload.protocol import Version
+
+
+class BackupError(Exception):
+    """The backup file cannot be written; nothing may be flashed then."""
+
+
+def to_mcm(macros: dict[int, str], version: Version, *, port: str, address: int,
+           when: _dt.datetime | None = None) -> str:
+    """The .mcm text: a header comment, `target`, then one `[MCnn]` line per stored slot."""
+    when = when or _dt.datetime.now().astimezone()
+    head = [
+        "// Mercury(TM) Macro File",
+        f"// read by mercmac {__version__} from {port}, address {address}, "
+        f"on {when.isoformat(timespec='seconds')}",
+        f"// controller: {version.model}, firmware {version.firmware}",
+        f"// VE: {_comment_safe(version.text)}",
+        f"// {len(macros)} macro{'s' if len(macros) != 1 else ''} stored",
+        f"target {version.model}",
+        "",
+    ]
+    body = [f"[MC{slot:02d}] {text}" for slot, text in sorted(macros.items())]
+    return "\n".join(head + body) + "\n"
+
+
+def default_path(port: str, address: int, when: _dt.datetime | None = None) -> Path:
+    """A timestamped file in the per-user data directory: never overwrites an older backup."""
+    import platformdirs
+
+    when = when or _dt.datetime.now()
+    folder = Path(platformdirs.user_data_dir("mercmac", appauthor=False)) / "backups"
+    stem = f"{_port_tag(port)}-addr{address}-{when.strftime('%Y%m%d-%H%M%S')}"
+    path, n = folder / f"{stem}.mcm", 1
+    while path.exists():
+        n += 1
+        path = folder / f"{stem}-{n}.mcm"
+    return path
+
+
+def save(text: str, path: Path) -> Path:
+    """Write atomically and durably: a power cut leaves the old file or the whole new one."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=".mercmac-", suffix=".tmp", dir=path.parent)
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except OSError as e:
+        raise BackupError(f"cannot write {path}: {e.strerror or e}") from None
+    return path
+
+
+def _port_tag(port: str) -> str:
+    """'/dev/ttyUSB0' -> 'ttyUSB0', 'socket://lab:4001' -> 'lab-4001': safe in a file name."""
+    tail = re.split(r"[/\\]+", port.split("://", 1)[-1].rstrip("/\\"))[-1] or "port"
+    return re.sub(r"[^A-Za-z0-9_.-]+", "-", tail).strip("-") or "port"
+
+
+def _comment_safe(text: str) -> str:
+    return "".join(c if c.isprintable() else "?" for c in text)

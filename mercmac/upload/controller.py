@@ -1,0 +1,176 @@
+"""Commands to one controller over a transport: select, identify, read and write macros.
+
+Every reply is checked against the shape MS176E gives it; reports that do not
+fit (stale output of a macro that ran when we connected) are skipped and
+quoted if nothing else comes. Reads are repeated once, writes never: a write
+is checked by reading it back (flasher.py).
+"""
+from __future__ import annotations
+
+import time
+from typing import Callable
+
+from mercmac.upload import protocol
+from mercmac.upload.protocol import ProtocolError, Status, Version
+from mercmac.upload.transport import PortLost, ReadTimeout, Transport, TransportError
+
+READ_ATTEMPTS = 2  # a read is harmless to repeat; a lost character in `TM5` costs one retry
+
+
+class ControllerError(Exception):
+    """A command did not get the reply it needs; says what was sent and what came."""
+
+    def __init__(self, message: str, *, sent: str = "", reply: str | None = None):
+        super().__init__(message)
+        self.sent, self.reply = sent, reply
+
+
+class NoAnswer(ControllerError):
+    """Silence where the manual promises a report."""
+
+
+class BadReply(ControllerError):
+    """Something came, but not what the command reports."""
+
+
+class LinkLost(ControllerError):
+    """The port failed under us."""
+
+
+class Controller:
+    """The controller at one address on an open transport."""
+
+    def __init__(self, transport: Transport, address: int = 0):
+        self.transport, self.address = transport, address
+
+    def select(self) -> None:
+        """Send the address selection code; a deselected controller ignores all else (§3.1)."""
+        self._send(protocol.select(self.address))  # 0x01 + address character, no CR (§3.1.1)
+
+    def status(self, timeout: float | None = None) -> Status | None:
+        """TS by its single character `%`, which does not stop a running macro (§6.3); None if silent."""
+        self.transport.discard_input()
+        self._send(protocol.STATUS_CHAR)  # '%': single-character TS, no CR (§6.3)
+        try:
+            return protocol.parse_status(self._await("%", protocol.is_status, timeout))
+        except (NoAnswer, BadReply):
+            return None  # silence or noise here is judged by the VE that follows
+
+    def identify(self) -> Version:
+        """VE: model and firmware (§3.3). Its first character also stops a running macro (§3.8.3)."""
+        return protocol.parse_version(self._ask("VE", protocol.is_version))
+
+    def read_slot(self, slot: int) -> str | None:
+        """One macro by `TMn`, or `TZ` for macro 0 (`TM0` lists all but 0); None when empty."""
+        line = "TZ" if slot == 0 else f"TM{slot}"
+        report = self._ask(line, lambda r: _lists_only(r, {slot}))
+        return self._macros(report, line).get(slot)
+
+    def read_all(self) -> dict[int, str]:
+        """Every stored macro: `TM` for 1-31 in either framing of SPEC §4, then `TZ`."""
+        first = self._ask("TM", lambda r: _lists_only(r, set(range(1, 32))))
+        macros = self._macros(first, "TM")
+        if len(protocol.lines(first)) == 1:
+            # One line then ETX: either the only macro, or the first of an
+            # ETX-per-line listing (SPEC §4). More lines follow without a pause.
+            self._listing_rest(macros)
+        zero = self.read_slot(0)
+        if zero:
+            macros[0] = zero
+        return dict(sorted(macros.items()))
+
+    def define(self, slot: int, line: str) -> None:
+        """MDn,...: store a macro; the controller neither answers nor warns (§3.8.1)."""
+        self._send(protocol.command(f"MD{slot},{line}"))
+
+    def remove(self, slot: int) -> None:
+        """Erase one macro: `RZ` for 0, `RMn` otherwise; never a bare `RM`, which erases all (§6.4 RM)."""
+        if slot == 0:
+            self._send(protocol.command("RZ"))
+        elif 1 <= slot <= 31:
+            self._send(protocol.command(f"RM{slot}"))
+        else:
+            raise ValueError(f"no macro slot {slot}")
+
+    def reset(self) -> None:
+        """RT: restart as after power-on, so macro 0 runs; the controller is then deselected (§6.4 RT, §3.1)."""
+        self._send(protocol.command("RT"))
+
+    def _send(self, data: bytes) -> None:
+        try:
+            self.transport.write(data)
+        except TransportError as e:
+            raise LinkLost(str(e), sent=protocol.show(data)) from None
+
+    def _ask(self, line: str, accept: Callable[[str], bool]) -> str:
+        """Send a report command and return the first report `accept` takes."""
+        data = protocol.command(line)
+        for attempt in range(READ_ATTEMPTS):
+            try:
+                self.transport.discard_input()
+            except TransportError as e:
+                raise LinkLost(str(e), sent=line) from None
+            self._send(data)
+            try:
+                return self._await(line, accept)
+            except (NoAnswer, BadReply):
+                if attempt + 1 == READ_ATTEMPTS:
+                    raise
+
+    def _await(self, line: str, accept: Callable[[str], bool], timeout: float | None = None) -> str:
+        """Reports until one fits; stale ones skipped, all bounded by the transport's budget."""
+        skipped: list[str] = []
+        stop = time.monotonic() + self.transport.timing.budget(self.transport.baud)
+        while True:
+            try:
+                report = self.transport.read_report(timeout)
+            except PortLost as e:
+                raise LinkLost(str(e), sent=line) from None
+            except ReadTimeout as e:
+                raise self._silence(line, skipped, e.partial) from None
+            if accept(report):
+                return report
+            skipped.append(report)
+            if time.monotonic() > stop:
+                raise self._silence(line, skipped, "")
+
+    def _silence(self, line: str, skipped: list[str], partial: str) -> ControllerError:
+        timeout = self.transport.timing.timeout
+        if skipped or partial.strip():
+            last = skipped[-1] if skipped else partial
+            return BadReply(f"unexpected answer to {line}: {protocol.quote(last)}",
+                            sent=line, reply=last)
+        return NoAnswer(f"no answer to {line} within {timeout:g} s", sent=line)
+
+    def _macros(self, report: str, line: str) -> dict[int, str]:
+        try:
+            return protocol.parse_macros(report)
+        except ProtocolError as e:
+            raise BadReply(f"unexpected answer to {line}: {e} {protocol.quote(report)}",
+                           sent=line, reply=report) from None
+
+    def _listing_rest(self, macros: dict[int, str]) -> None:
+        """Further one-line reports of a TM listing, until `settle` seconds of quiet."""
+        while True:
+            try:
+                report = self.transport.read_report(self.transport.timing.settle)
+            except PortLost as e:
+                raise LinkLost(str(e), sent="TM") from None
+            except ReadTimeout as e:
+                if e.partial.strip():
+                    raise BadReply(f"TM listing cut short: {protocol.quote(e.partial)}",
+                                   sent="TM", reply=e.partial) from None
+                return
+            if _lists_only(report, set(range(1, 32))):
+                for slot, text in self._macros(report, "TM").items():
+                    if macros.get(slot, text) != text:
+                        raise BadReply(f"TM listed macro {slot} twice with different contents",
+                                       sent="TM", reply=report)
+                    macros[slot] = text
+
+
+def _lists_only(report: str, slots: set[int]) -> bool:
+    """A TM/TZ answer naming only `slots`: empty, or `MCnnn` lines of those (SPEC §4)."""
+    if not protocol.is_macro_report(report):
+        return False
+    return all(protocol.parse_macro_line(line)[0] in slots for line in protocol.lines(report))

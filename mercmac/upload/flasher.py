@@ -1,0 +1,255 @@
+"""Flashing a program: back up, write what differs in the safe order, verify, report.
+
+SPEC §4 rules 3-8. The controller is identified first (session.identify);
+everything it holds is saved before the first write; each write is read back,
+written once more on a mismatch, and a failure stops the flash with a message
+that says what was written, what was not, and where the backup is.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+from mercmac.compiler.program import Program
+from mercmac.upload import backup, protocol
+from mercmac.upload.controller import Controller, ControllerError, LinkLost
+from mercmac.upload.errors import FlashFailed, FlashInterrupted, Refused
+from mercmac.upload.plan import Action, Plan, Step, make_plan
+from mercmac.upload.session import Identity, refusal
+
+CLEANUP_TIMEOUT = 0.5  # s: after Ctrl-C, how long one tidy-up read may take
+
+
+@dataclass(frozen=True, slots=True)
+class Event:
+    """Something to show while flashing; `done`/`total` drive a progress bar."""
+
+    kind: str  # backup, plan, step, verified, retry, repair, reset
+    text: str
+    done: int = 0
+    total: int = 0
+
+
+Notify = Callable[[Event], None]
+
+
+@dataclass(slots=True)
+class FlashOptions:
+    """What the user asked for on the command line."""
+
+    erase_unused: bool = False
+    dry_run: bool = False
+    reset: bool = False
+    backup: Path | None = None
+
+
+@dataclass(slots=True)
+class FlashResult:
+    """A finished flash (or dry run): the plan, the backup, and what needed a second try."""
+
+    identity: Identity
+    plan: Plan
+    backup: Path | None
+    dry_run: bool = False
+    reset: bool = False
+    retried: list[int] = field(default_factory=list)
+    repaired: list[int] = field(default_factory=list)
+
+    def wire(self, address: int) -> list[tuple[bytes, str]]:
+        """The exact bytes a flash sends after reading back, with what each is for."""
+        out = [(protocol.select(address), "address selection (0x01 + address)")]
+        for step in self.plan.steps:
+            out.append((protocol.command(step.wire), f"{step.action.value} {step.name}"))
+            out.append((protocol.command(step.readback), f"read back {step.name}"))
+        if self.reset:
+            out.append((protocol.command("RT"), "reset: macro 0 starts"))
+        return out
+
+
+def flash(controller: Controller, identity: Identity, program: Program,
+          options: FlashOptions, notify: Notify = lambda e: None) -> FlashResult:
+    """Read back, back up, write and verify; FlashFailed names the state on any failure."""
+    try:
+        stored = controller.read_all()  # TM, TZ (SPEC §4 rule 3)
+    except ControllerError as e:
+        raise refusal(controller, e) from None
+    plan = make_plan(program, stored, erase_unused=options.erase_unused)
+    result = FlashResult(identity, plan, None, options.dry_run, options.reset)
+    if options.dry_run:
+        return result
+    result.backup = _save_backup(controller, identity, stored, options.backup)
+    notify(Event("backup", f"backup of {len(stored)} stored macros: {result.backup}"))
+    run = _Run(controller, plan, notify, result)
+    run.execute()
+    if options.reset:
+        run.reset()
+    return result
+
+
+def _save_backup(controller: Controller, identity: Identity, stored: dict[int, str],
+                 path: Path | None) -> Path:
+    t = controller.transport
+    text = backup.to_mcm(stored, identity.version, port=t.port, address=controller.address)
+    try:
+        return backup.save(text, path or backup.default_path(t.port, controller.address))
+    except backup.BackupError as e:
+        raise Refused(f"{e}; nothing was written to the controller",
+                      hint="give a writable file with --backup PATH") from None
+
+
+class _Run:
+    """The steps of one plan against one controller, with what we believe it now holds."""
+
+    def __init__(self, controller: Controller, plan: Plan, notify: Notify, result: FlashResult):
+        self.c, self.plan, self.notify, self.result = controller, plan, notify, result
+        self.believed = dict(plan.before)
+        self.done: list[Step] = []
+        self.current: Step | None = None
+
+    def execute(self) -> None:
+        total = len(self.plan.steps)
+        try:
+            for i, step in enumerate(self.plan.steps):
+                self.current = step
+                self.notify(Event("step", f"{step.action.value} {step.name}", i, total))
+                self._apply(step)
+                self.done.append(step)
+                self.current = None
+                self.notify(Event("verified", f"{step.action.value} {step.name}: verified",
+                                  i + 1, total))
+        except KeyboardInterrupt:
+            raise FlashInterrupted(self._report("interrupted (Ctrl-C)", alive=True),
+                                   hint=self._hint()) from None
+        except _Mismatch as e:
+            raise FlashFailed(self._report(str(e), alive=True), hint=self._hint()) from None
+        except ControllerError as e:
+            alive = not isinstance(e, LinkLost)
+            raise FlashFailed(self._report(_cause(e), alive=alive), hint=self._hint()) from None
+
+    def reset(self) -> None:
+        try:
+            self.c.reset()  # RT: macro 0 starts as after power-on (MS176E §6.4 RT)
+        except ControllerError as e:
+            raise FlashFailed(f"all macros are written and verified, but RT failed: {_cause(e)}",
+                              hint="power-cycle the controller to start macro 0") from None
+        self.notify(Event("reset", "RT sent: the controller restarts and runs macro 0"))
+
+    def _apply(self, step: Step) -> None:
+        """Send, read back; on a mismatch repair what a lost character hit and send once more."""
+        self._send(step)
+        got = self.c.read_slot(step.slot)
+        if not protocol.same_macro(got, step.expected):
+            self.notify(Event("retry", f"{step.name} read back wrong "
+                                       f"({protocol.difference(step.expected, got)}); writing it again"))
+            self.result.retried.append(step.slot)
+            self._reconcile(step.slot)
+            self._send(step)
+            got = self.c.read_slot(step.slot)
+            if not protocol.same_macro(got, step.expected):
+                raise _Mismatch(f"{step.name} does not verify after a second write: "
+                                f"{protocol.difference(step.expected, got)}")
+        self.believed[step.slot] = step.expected
+        if step.expected is None:
+            self.believed.pop(step.slot, None)
+
+    def _reconcile(self, skip: int) -> None:
+        """Re-read every slot: a lost digit sends `MD15` to slot 1, a lost one `RM5` erases all."""
+        actual = self.c.read_all()
+        for slot in sorted(actual.keys() | self.believed.keys()):
+            want = self.believed.get(slot)
+            if slot == skip or protocol.same_macro(actual.get(slot), want):
+                continue
+            fix = Step(Action.WRITE if want else Action.ERASE, slot,
+                       self.plan.names.get(slot, f"MC{slot:02d}"), want)
+            self.notify(Event("repair", f"{fix.name} was changed by a garbled line; restoring it"))
+            self._send(fix)
+            got = self.c.read_slot(slot)
+            if not protocol.same_macro(got, want):
+                raise _Mismatch(f"{fix.name} was hit by a garbled line and does not verify "
+                                f"after repair: {protocol.difference(want, got)}")
+            self.result.repaired.append(slot)
+
+    def _send(self, step: Step) -> None:
+        if step.action is Action.WRITE:
+            self.c.define(step.slot, step.line)
+        else:
+            self.c.remove(step.slot)
+
+    def _report(self, cause: str, *, alive: bool) -> str:
+        """What was written, what was not, the state of macro 0 and where the backup is."""
+        zero = self._settle_autostart(alive)
+        current = self.current
+        pending = self.plan.steps[len(self.done) + (current is not None):]
+        lines = [f"flash stopped: {cause}",
+                 "  written and verified: " + (_names(self.done) or "nothing")]
+        if current:
+            lines.append(f"  in progress, state unknown: {current.action.value} {current.name}")
+        lines += ["  not written: " + (_names(pending) or "nothing"),
+                  "  macro 0: " + zero,
+                  f"  backup of the controller as it was: {self.result.backup}"]
+        return "\n".join(lines)
+
+    def _settle_autostart(self, alive: bool) -> str:
+        """Macro 0's state for the report; a half-written macro 0 is removed if the link lives."""
+        current = self.current
+        if current and current.slot == 0 and current.action is Action.WRITE:
+            if alive and self._unarm(current):
+                return "its write did not complete, so it was removed: the controller will not autostart"
+            if current in self.done:
+                return "written last and verified"
+            return ("its write was in progress and it may be incomplete: check with "
+                    "`mercmac pull` and remove it (RZ) before the next power-on")
+        if current and current.action is Action.PARK:
+            return ("was being removed: either gone, or still the old autostart with "
+                    "nothing it calls touched yet")
+        if any(s.slot == 0 and s.action is Action.WRITE for s in self.done):
+            return "written last and verified"
+        if any(s.action is Action.PARK for s in self.done):
+            return ("removed before the first write and not written back: the controller "
+                    "will not autostart a half-written program")
+        if 0 in self.believed:
+            return "unchanged"
+        if 0 in self.plan.after:
+            return "not written yet: the controller will not autostart a half-written program"
+        return "none: the controller will not autostart"
+
+    def _unarm(self, step: Step) -> bool:
+        """After a failed write of macro 0: keep it if it verifies, else RZ; False if unsure."""
+        try:
+            self.c.transport.timing = _short(self.c.transport.timing)
+            if protocol.same_macro(self.c.read_slot(0), step.expected):
+                self.done.append(step)
+                self.current = None
+                return False
+            self.c.remove(0)  # RZ: no autostart beats a garbled one (MS176E §3.8.5)
+            return self.c.read_slot(0) is None
+        except (ControllerError, KeyboardInterrupt):
+            return False
+
+    def _hint(self) -> str:
+        t = self.c.transport
+        return (f"run the same `mercmac flash` again to finish (it writes only what differs); "
+                f"`mercmac flash {t.port} {self.result.backup} --erase-unused` puts the old "
+                f"program back")
+
+
+class _Mismatch(Exception):
+    """A write that does not read back right, even after the second try."""
+
+
+def _names(steps: list[Step]) -> str:
+    return ", ".join(f"{s.name}" + (" (erase)" if s.action is not Action.WRITE else "")
+                     for s in steps)
+
+
+def _cause(e: ControllerError) -> str:
+    if isinstance(e, LinkLost):
+        return f"the port went away ({e})"
+    return str(e)
+
+
+def _short(timing):
+    from dataclasses import replace
+
+    return replace(timing, timeout=min(timing.timeout, CLEANUP_TIMEOUT))

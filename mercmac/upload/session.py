@@ -1,0 +1,100 @@
+"""Opening a port and meeting the controller there: select, stop, identify (SPEC §4 rule 2).
+
+Errors of the lower layers are reworded here into `UploadError`s that say
+what to check; nothing in this module writes a macro.
+"""
+from __future__ import annotations
+
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Callable, Iterator
+
+from mercmac.upload.controller import BadReply, Controller, ControllerError, LinkLost, NoAnswer
+from mercmac.upload.errors import PortError, Refused
+from mercmac.upload.protocol import Version
+from mercmac.upload.transport import DEFAULT_BAUD, PortUnavailable, Timing, Transport
+
+
+@dataclass(frozen=True, slots=True)
+class Identity:
+    """Who answered: VE's model and firmware, and whether we stopped a running macro."""
+
+    version: Version
+    stopped_macro: bool
+
+
+@contextmanager
+def open_controller(port: str, address: int = 0, *, baud: int = DEFAULT_BAUD,
+                    timing: Timing = Timing(),
+                    tap: Callable[[str, bytes], None] | None = None) -> Iterator[Controller]:
+    """A Controller on a freshly opened port, closed again on the way out."""
+    try:
+        transport = Transport(port, baud, timing, tap)
+    except PortUnavailable as e:
+        raise PortError(str(e), hint=_port_hint(str(e))) from None
+    with transport:
+        yield Controller(transport, address)
+
+
+def identify(controller: Controller) -> Identity:
+    """Select the address, stop a running macro, read VE; Refused if nothing fits."""
+    try:
+        controller.select()
+        before = controller.status()  # '%' answers without stopping a macro (MS176E §6.3)
+        version = controller.identify()  # 'V' stops a running macro (MS176E §3.8.3)
+        running = bool(before and before.macro_running)
+        if running and (after := controller.status()) and after.macro_running:
+            raise Refused(f"{_where(controller)} keeps running a macro after VE; nothing was written",
+                          hint="stop it with any key in a terminal, or power-cycle it")
+    except ControllerError as e:
+        raise refusal(controller, e) from None
+    return Identity(version, running)
+
+
+def refusal(controller: Controller, e: ControllerError) -> Refused:
+    """A lower-layer failure before the first write, as a message with a cause and a hint."""
+    where = _where(controller)
+    if isinstance(e, NoAnswer):
+        return Refused(f"nothing answers at {where} ({e}); nothing was written",
+                       hint=_silence_hint(controller))
+    if isinstance(e, BadReply):
+        return Refused(f"the device at {where} does not answer like a Mercury controller: "
+                       f"{e}; nothing was written",
+                       hint=f"a baud rate other than the controller's garbles replies: check "
+                            f"DIP switches 5-6 against --baud {controller.transport.baud}")
+    if isinstance(e, LinkLost):
+        return Refused(f"the port failed before anything was written: {e}",
+                       hint="check the cable and that the USB adapter is still there")
+    return Refused(f"{where}: {e}; nothing was written")
+
+
+def check_model(identity: Identity, target: str | None, file: str, *, force: bool) -> str | None:
+    """Refuse when the controller is not the file's target; with force, the warning to show."""
+    model = identity.version.model
+    if target is None or target == model:
+        return None
+    text = f"the controller is a {model}, but {file or 'the program'} targets the {target}"
+    if force:
+        return text + " (flashing anyway: --force)"
+    raise Refused(text + "; nothing was written",
+                  hint=f"use --force to flash it anyway, or --target {model} to check the "
+                       f"file against this controller")
+
+
+def _where(controller: Controller) -> str:
+    return f"address {controller.address} on {controller.transport.port}"
+
+
+def _silence_hint(controller: Controller) -> str:
+    return (f"check power and cable, that DIP switches 1-4 set address {controller.address} "
+            f"(MS176E §3.1.3) and switches 5-6 the baud rate {controller.transport.baud}; "
+            f"`mercmac scan {controller.transport.port}` lists the addresses that answer")
+
+
+def _port_hint(message: str) -> str:
+    text = message.lower()
+    if "lock" in text or "busy" in text:
+        return "another program (a terminal, MMCRun, a second mercmac) has the port open"
+    if "permission" in text or "access is denied" in text:
+        return "on Linux, add yourself to the group owning the port (often `dialout`)"
+    return "`mercmac ports` lists the serial ports of this computer"

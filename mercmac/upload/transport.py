@@ -1,0 +1,149 @@
+"""A serial link with a timeout on every read: pyserial under, reports on top.
+
+Anything `serial.serial_for_url` opens works: COM3, /dev/ttyUSB0, a pty
+path, socket://host:port. The port is opened exclusively so that a terminal
+program left open cannot interleave its bytes with an upload.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+from mercmac.upload.protocol import ProtocolError, ReportSplitter
+
+DEFAULT_BAUD = 9600  # MS176E §3.3: MMCRun's rate, DIP switches 5 and 6 ON
+POLL_S = 0.02  # how long one pyserial read may block; bounds the reaction to Ctrl-C
+
+
+class TransportError(Exception):
+    """The port cannot be used: missing, busy, lost, or the controller is silent."""
+
+
+class PortUnavailable(TransportError):
+    """Opening the port failed."""
+
+
+class PortLost(TransportError):
+    """The port went away while in use (USB cable pulled, adapter reset)."""
+
+
+class ReadTimeout(TransportError):
+    """No complete report came in time; `partial` holds what did come."""
+
+    def __init__(self, message: str, partial: str = ""):
+        super().__init__(message)
+        self.partial = partial
+
+
+@dataclass(frozen=True, slots=True)
+class Timing:
+    """Read timeouts in seconds: per report, and the quiet time that ends a listing."""
+
+    timeout: float = 1.0  # silence after which a reply is given up (flash writes take a while)
+    settle: float = 0.25  # quiet time after an ETX that ends a multi-report TM listing
+
+    def budget(self, baud: int) -> float:
+        """Longest time one reply may take: a timeout plus a full-size report at `baud`."""
+        return self.timeout + 4096 * 10 / max(baud, 300) + 2.0
+
+
+class Transport:
+    """One open serial port; counts bytes both ways (benchmarks/flash_bytes.py)."""
+
+    def __init__(self, port: str, baud: int = DEFAULT_BAUD, timing: Timing = Timing(),
+                 tap: Callable[[str, bytes], None] | None = None):
+        self.port, self.baud, self.timing = port, baud, timing
+        self.sent = self.received = 0
+        self._tap = tap
+        self._splitter = ReportSplitter()
+        self._reports: list[str] = []
+        self._serial = _open(port, baud)
+
+    def __enter__(self) -> "Transport":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        try:
+            self._serial.close()
+        except Exception:  # closing a port that vanished must not hide the real error
+            pass
+
+    def write(self, data: bytes) -> None:
+        """Send `data` in one write (SPEC §4 rule 1), waiting until it has left."""
+        try:
+            written = self._serial.write(data)
+            self._serial.flush()
+        except Exception as e:
+            raise PortLost(f"writing to {self.port} failed: {_reason(e)}") from None
+        if written is not None and written != len(data):
+            raise PortLost(f"{self.port} took {written} of {len(data)} bytes")
+        self.sent += len(data)
+        if self._tap:
+            self._tap("out", data)
+
+    def discard_input(self) -> None:
+        """Forget bytes that arrived unasked: stale reports of a running macro."""
+        try:
+            self._serial.reset_input_buffer()
+            waiting = self._serial.in_waiting
+            if waiting:
+                self._take(self._serial.read(waiting))
+        except Exception as e:
+            raise PortLost(f"reading from {self.port} failed: {_reason(e)}") from None
+        self._splitter.clear()
+        self._reports.clear()
+
+    def read_report(self, timeout: float | None = None) -> str:
+        """The next report (text before ETX); ReadTimeout after `timeout` s of silence."""
+        limit = self.timing.timeout if timeout is None else timeout
+        quiet_since = time.monotonic()
+        hard_stop = quiet_since + self.timing.budget(self.baud)
+        while True:
+            if self._reports:
+                return self._reports.pop(0)
+            data = self._read_some()
+            now = time.monotonic()
+            if data:
+                quiet_since = now
+                try:
+                    self._reports.extend(self._splitter.feed(data))
+                except ProtocolError as e:
+                    raise ReadTimeout(str(e), e.reply or "") from None
+            elif now - quiet_since >= limit or now >= hard_stop:
+                raise ReadTimeout(f"no complete reply within {limit:g} s", self._splitter.pending())
+
+    def _read_some(self) -> bytes:
+        try:
+            self._serial.timeout = POLL_S
+            waiting = self._serial.in_waiting
+            return self._take(self._serial.read(max(1, waiting)))
+        except Exception as e:
+            raise PortLost(f"reading from {self.port} failed: {_reason(e)}") from None
+
+    def _take(self, data: bytes) -> bytes:
+        self.received += len(data)
+        if data and self._tap:
+            self._tap("in", data)
+        return data
+
+
+def _open(port: str, baud: int):
+    """The pyserial object for a port name or URL; PortUnavailable with the reason."""
+    import serial
+
+    try:
+        # 8N1, no flow control: the Mercury defaults (MS176E §3.3, User Manual)
+        return serial.serial_for_url(port, baudrate=baud, timeout=POLL_S, write_timeout=10,
+                                     exclusive=True)
+    except (serial.SerialException, OSError, ValueError) as e:
+        raise PortUnavailable(f"cannot open {port}: {_reason(e)}") from None
+
+
+def _reason(e: BaseException) -> str:
+    """pyserial's message without its errno prefix noise."""
+    text = str(getattr(e, "strerror", None) or e).strip()
+    return text or type(e).__name__
