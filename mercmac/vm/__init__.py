@@ -1,0 +1,13 @@
+"""The simulator core: a bytecode VM of a Mercury controller (SPEC §3).
+
+    Machine(program, model=..., cycle_ms=1.0, options=Options(...), on_report=f)
+    .power_on() .load(p) .define(slot, ops) .execute_line(ops) .start_macro(n) .stop()
+    .run_until(t_ms) .set_input(n, on) .running .now_ms .macro .position() .target
+    .velocity() .outputs_pattern() .status() .error
+
+Report strings live in `mercmac.vm.reports`.
+"""
+from mercmac.vm.machine import Hardware, Machine
+from mercmac.vm.models import Options
+
+__all__ = ["Hardware", "Machine", "Options"]

@@ -1,0 +1,59 @@
+"""The I/O lines: inputs 1-6 with their scheduled changes, outputs 1-4 (the C-170.PB LEDs)."""
+from __future__ import annotations
+
+import bisect
+import math
+
+INPUTS = range(1, 7)  # 1-4 pushbuttons, 5 joystick (ON above mid-scale), 6 joystick button
+
+
+class Inputs:
+    """Input lines and the changes scheduled for them (a button script)."""
+
+    def __init__(self):
+        self.state = [False] * 7  # index 0 unused
+        self._due: list[tuple[int, int, int, bool]] = []  # (t_us, order, input, on)
+        self.version = 0  # bumps on every change: fast-forward must not skip one
+
+    def __getitem__(self, n: int) -> bool:
+        return self.state[n]
+
+    def schedule(self, t_us: int, n: int, on: bool) -> None:
+        """Set input n at time t_us; changes at the same time apply in scheduling order."""
+        bisect.insort(self._due, (t_us, len(self._due), n, on))
+
+    def next_change(self) -> float:
+        return self._due[0][0] if self._due else math.inf
+
+    def pop_due(self, t_us: int) -> list[tuple[int, bool]]:
+        """Changes due at or before t_us, removed from the schedule, that change a line."""
+        changed = []
+        while self._due and self._due[0][0] <= t_us:
+            _, _, n, on = self._due.pop(0)
+            if self.set(n, on):
+                changed.append((n, on))
+        return changed
+
+    def set(self, n: int, on: bool) -> bool:
+        """Set a line now; True if it changed."""
+        if self.state[n] == on:
+            return False
+        self.state[n] = on
+        self.version += 1
+        return True
+
+    def pattern(self) -> int:
+        """Inputs 1-4 as bits 0-3 (TC0, §6.4 TC)."""
+        return sum(1 << (n - 1) for n in range(1, 5) if self.state[n])
+
+
+class Outputs:
+    """Four digital outputs; output 4 also carries trigger pulses (§4.5.2)."""
+
+    def __init__(self):
+        self.set_bits = 0  # what CN/CF/CP programmed
+        self.pulse_until = -math.inf  # output 4 is high for a trigger pulse until then
+
+    def pattern(self, t_us: float) -> int:
+        """The 4-bit pattern the LEDs show at t_us (bit 0 = output 1, §6.4 CP)."""
+        return self.set_bits | (8 if t_us < self.pulse_until else 0)

@@ -1,0 +1,55 @@
+"""Power-on defaults per controller model (MS176E §3.4.1, §3.4.2) and simulator options."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mercmac.commands import C663, C863, MAX_INT32, MODELS
+from mercmac.errors import UsageError
+
+
+@dataclass(frozen=True, slots=True)
+class Defaults:
+    """What a controller holds after power-on or RT (§6.4 RT: "restored to their defaults")."""
+
+    sv: int
+    sa: int
+    jh: int
+    jl: int
+    limits_high: bool  # LH (active high) or LL (active low)
+    settings: tuple[tuple[str, int], ...]  # values reported by GP, FP?, WW?, ...
+
+
+DEFAULTS = {
+    # §3.4.1: SV 45000, SA 400000, DP 35, DI 0, DD 0, DL 2000, FP 35, FL 2000,
+    # FT/FN 10000 Hz, FQ 0.8 (80), LH, LN, BN, JH/JL +-100,000,000, WT 0, WW 5;
+    # §6.4 SM default 2000.
+    C863: Defaults(45_000, 400_000, 100_000_000, -100_000_000, True, (
+        ("DP", 35), ("DI", 0), ("DD", 0), ("DL", 2000), ("FM", 0), ("FP", 35), ("FI", 0),
+        ("FD", 0), ("FL", 2000), ("FT", 10_000), ("FN", 10_000), ("FQ", 80), ("FS", 0),
+        ("FA", 0), ("FO", 0), ("WT", 0), ("WW", 5), ("SM", 2000), ("SB", 0), ("SF", 0),
+        ("JB", 0), ("JA", 0), ("SI", 0), ("SJ", 0))),
+    # §3.4.2: SV 20000, SA 250000, DC 200 mA, HC 100 mA, HT 200 ms, LL, LN, BN; the
+    # manual gives no soft limits for the C-663, so they start cleared (§6.4 JC values).
+    C663: Defaults(20_000, 250_000, MAX_INT32, -MAX_INT32, False, (
+        ("DC", 200), ("HC", 100), ("HT", 200), ("JB", 0), ("JA", 0), ("SI", 0), ("SJ", 0))),
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Options:
+    """Bench facts the manual leaves open; each has a command-line option in `mercmac sim`."""
+
+    servo_on: bool = True  # SPEC §3: the manual's stand-alone examples never send MN
+    reference_at: int = 0  # position of the reference switch edge (SPEC §3, §4.3)
+    hard_limits: tuple[int, int] | None = None  # (negative, positive) limit switch positions
+    address: int = 0  # DIP switches 1-4, what TB reports (§6.4 TB)
+
+
+def model_name(name: str | None) -> str:
+    """'c-663' -> 'C-663'; None -> C-863 (SPEC §3 default); anything else is a usage error."""
+    if name is None:
+        return C863
+    upper = name.upper()
+    if upper not in MODELS:
+        raise UsageError(f"unknown controller model '{name}': use {' or '.join(MODELS)}")
+    return upper

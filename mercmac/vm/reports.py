@@ -1,0 +1,147 @@
+"""Report strings exactly as the firmware sends them, without CR LF ETX (MS176E §6.1.3, §6.4).
+
+The one place that formats reports: the simulator and the virtual controller
+of `mercmac emulate` both call `report()`.
+"""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from mercmac.commands import C663, COMMANDS
+
+if TYPE_CHECKING:
+    from mercmac.vm.machine import Machine
+
+# §6.4 CS and VE examples; the model name in VE is how a host tells C-663 from C-863.
+CHECKSUM = "C:0230-15"
+VERSION = "(c)2009 Physik Instrumente(PI) Karlsruhe, {model}, Ver. 2.30, 2009-21-07"
+TABLE_DONE = "Table done"  # §6.4 JT: sent when the table is generated
+
+# §6.2 "Corresponding Report Command": G* report the D* settings.
+_GETS = {"GD": "DD", "GI": "DI", "GL": "DL", "GP": "DP"}
+# Queries whose examples in §6.4 show no sign ("FM:1", "JN:20000", "WW:5"); the
+# others show one ("JH:+250000", "ZP:+30000").
+_UNSIGNED = frozenset({"FM?", "FN?", "FQ?", "FS?", "FT?", "JA?", "JN?", "WT?", "WW?", "ZM?", "SI?"})
+
+
+def number(identifier: str, value: float) -> str:
+    """'P:+0000005555': sign and ten digits (§6.4 TP, TT, TI, TL, GL examples)."""
+    return f"{identifier}{round(value):+011d}"
+
+
+def report(mnemonic: str, arg: int | None, m: Machine) -> str:
+    """The report of one report command (kind REPORT in the command table)."""
+    ident = COMMANDS[mnemonic].report or ""
+    if mnemonic.endswith("?"):
+        return _query(mnemonic, ident, m)
+    if mnemonic in _GETS:
+        return number(ident, m.params.get(_GETS[mnemonic], 0))
+    t = m.clock.now
+    axis = m.axis
+    match mnemonic:
+        case "TP":
+            return number(ident, axis.position(t))
+        case "TT":
+            return number(ident, axis.target)
+        case "TI":
+            return number(ident, m.iteration())
+        case "TL":
+            return number(ident, axis.sa)
+        case "TY":
+            return number(ident, axis.sv)
+        case "TV":
+            return number(ident, axis.velocity(t))
+        case "TD":  # the dynamic target: the profile's position (perfect tracking)
+            return number(ident, axis.position(t))
+        case "TE":  # §6.4 TE: target minus actual position
+            return number(ident, axis.target - round(axis.position(t)))
+        case "TF" | "TR":  # the model tracks perfectly and has no force sensor
+            return number(ident, 0)
+        case "TC":
+            return channel(arg or 0, m)
+        case "TA":
+            return analog(arg or 0, m)
+        case "TS":
+            return status(m)
+        case "TB":
+            return f"B:{m.options.address}"
+        case "CS":
+            return CHECKSUM
+        case "VE":
+            return VERSION.format(model=m.model)
+        case "TM":
+            return macros(m, [arg] if arg else [s for s in sorted(m.chunks) if s != 0])
+        case "TZ":
+            return macros(m, [0])
+    raise ValueError(f"no report format for {mnemonic}")
+
+
+def _query(mnemonic: str, ident: str, m: Machine) -> str:
+    """'JH:+250000', 'ZM:2': the value set by the command the query belongs to."""
+    setting = mnemonic[:-1]
+    value = {"JH": m.axis.jh, "JL": m.axis.jl, "JN": m.axis.joystick, "ZM": m.trigger.mode,
+             "ZP": m.trigger.position, "ZI": m.trigger.increment}.get(setting)
+    value = m.params.get(setting, 0) if value is None else value
+    return f"{ident}{value}" if mnemonic in _UNSIGNED else f"{ident}{value:+d}"
+
+
+def channel(n: int, m: Machine) -> str:
+    """TCn: 'H01:1'; TC0: all four inputs as one hex digit, 'H00:5' (§6.4 TC)."""
+    if n == 0:
+        return f"H00:{m.inputs.pattern():X}"
+    return f"H0{n}:{int(m.inputs[n])}"
+
+
+def analog(n: int, m: Machine) -> str:
+    """TAn: 8-bit readings; a digital line reads 255 when ON. The joystick (5) rests at
+    mid-scale, 128, and reads 255 at full tilt (SPEC §3: ON above mid-scale)."""
+    def value(k: int) -> int:
+        if k == 5:
+            return 255 if m.inputs[5] else 128
+        return 255 if m.inputs[k] else 0
+    if n == 0:  # §6.4 TA: "A:185" followed by the other channels, one per line
+        return "A:" + "\r\n".join(str(value(k)) for k in range(1, 5))
+    return f"A{n}:{value(n)}"
+
+
+def status(m: Machine) -> str:
+    """TS: six bytes on the C-863, three on the C-663 (§6.4 TS tables)."""
+    blocks = _status_663(m) if m.model == C663 else _status_863(m)
+    return "S:" + " ".join(f"{b:02X}" for b in blocks)
+
+
+def _bits(*flags: bool) -> int:
+    return sum(1 << i for i, on in enumerate(flags) if on)
+
+
+def _status_863(m: Machine) -> list[int]:
+    t, axis = m.clock.now, m.axis
+    on_target = not axis.moving(t)
+    limit = axis.limit_switch(t)
+    return [
+        _bits(0, 0, on_target, axis.referenced, 0, 0, 0, not axis.servo),
+        _bits(0, True, 0, 0, m.running),  # bit 1 busy: it is executing this very TS
+        _bits(0, 0, axis.negative),
+        _bits(m.limits_on, m.limits_high, axis.homing, m.brake, axis.joystick > 0),
+        _bits(0, axis.reference_high(t), limit == "positive", limit == "negative")
+        | (m.inputs.pattern() << 4),
+        m.error,
+    ]
+
+
+def _status_663(m: Machine) -> list[int]:
+    t, axis = m.clock.now, m.axis
+    limit = axis.limit_switch(t)
+    moving = axis.moving(t)
+    return [
+        _bits(not m.running, not moving, axis.homing, axis.joystick > 0, m.running,
+              not axis.servo, m.brake, moving),
+        _bits(limit == "negative", axis.reference_high(t), limit == "positive")
+        | (m.inputs.pattern() << 4),
+        m.error,
+    ]
+
+
+def macros(m: Machine, slots: list[int]) -> str:
+    """TM/TZ: 'MC001 MR55555' per stored macro, one per line; '' when none (SPEC §4)."""
+    return "\r\n".join(f"MC{s:03d} {m.chunks[s].line}" for s in slots if s in m.chunks)

@@ -1,0 +1,63 @@
+"""One scripted simulation: power on, press buttons on schedule, run to a time (SPEC §5 `sim`)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterable
+
+from mercmac.compiler.program import Program
+from mercmac.timespec import Press
+from mercmac.vm.machine import Machine
+from mercmac.vm.models import Options
+from mercmac.vm.record import Recorder
+
+DEFAULT_UNTIL_MS = 10_000  # SPEC §5: --until defaults to 10s
+
+
+@dataclass(slots=True)
+class Run:
+    """What a simulation produced: the recorder, and the machine as it stands at the end."""
+
+    machine: Machine
+    record: Recorder
+    until_ms: int
+
+    @property
+    def halted(self) -> bool:
+        """SPEC §5: the program ended before until_ms (nothing runs any more)."""
+        return not self.machine.running
+
+    def final(self) -> dict:
+        m = self.machine
+        return {"t_ms": self.until_ms, "position": m.position(), "target": m.target,
+                "outputs": m.outputs_pattern(), "velocity": m.velocity(), "macro": m.macro}
+
+
+def schedule(machine: Machine, presses: Iterable[Press]) -> None:
+    """Turn `--buttons` presses into timed input changes."""
+    for press in presses:
+        for n in press.inputs:
+            machine.schedule_input(press.start_ms, n, True)
+            if press.end_ms is not None:
+                machine.schedule_input(press.end_ms, n, False)
+
+
+def machine_for(program: Program, *, model: str | None = None, cycle_ms: float = 1.0,
+                options: Options | None = None, trace: bool = False,
+                macro_changes: bool = False) -> tuple[Machine, Recorder]:
+    """A machine with a recorder attached, not yet powered on."""
+    record = Recorder(macro_changes=macro_changes)
+    machine = Machine(program, model=model, cycle_ms=cycle_ms, options=options,
+                      on_event=record.on_event, trace=trace)
+    return machine, record
+
+
+def simulate(program: Program, *, presses: Iterable[Press] = (), until_ms: int = DEFAULT_UNTIL_MS,
+             model: str | None = None, cycle_ms: float = 1.0, options: Options | None = None,
+             trace: bool = False, macro_changes: bool = False) -> Run:
+    """Power on at t = 0 (macro 0 starts, SPEC §3 Power-on) and run to until_ms."""
+    machine, record = machine_for(program, model=model, cycle_ms=cycle_ms, options=options,
+                                  trace=trace, macro_changes=macro_changes)
+    schedule(machine, presses)
+    machine.power_on()
+    machine.run_until(until_ms)
+    return Run(machine, record, until_ms)
