@@ -72,13 +72,15 @@ def flash(controller: Controller, identity: Identity, program: Program,
     """Read back, back up, write and verify; FlashFailed names the state on any failure."""
     try:
         stored = controller.read_all()  # TM, TZ (SPEC §4 rule 3)
+        plan = make_plan(program, stored, erase_unused=options.erase_unused)
+        result = FlashResult(identity, plan, None, options.dry_run, options.reset)
+        if options.dry_run:
+            return result
+        result.backup = _save_backup(controller, identity, stored, options.backup)
     except ControllerError as e:
         raise refusal(controller, e) from None
-    plan = make_plan(program, stored, erase_unused=options.erase_unused)
-    result = FlashResult(identity, plan, None, options.dry_run, options.reset)
-    if options.dry_run:
-        return result
-    result.backup = _save_backup(controller, identity, stored, options.backup)
+    except KeyboardInterrupt:
+        raise FlashInterrupted("interrupted before the first write; nothing was written") from None
     notify(Event("backup", f"backup of {len(stored)} stored macros: {result.backup}"))
     run = _Run(controller, plan, notify, result)
     run.execute()

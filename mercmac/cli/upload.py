@@ -1,0 +1,208 @@
+"""`mercmac flash`, `pull`, `ports`, `scan` and `emulate`: thin click commands (SPEC §4, §5).
+
+The serial library, rich and the uploader are imported inside the command
+bodies so that `mercmac check` starts fast.
+"""
+from __future__ import annotations
+
+import click
+
+from mercmac.cli.common import MODEL_CHOICE, run_guarded
+from mercmac.errors import EXIT_FAILED, EXIT_OK, UsageError
+
+_ADDRESS = click.option("--address", type=click.IntRange(0, 15), default=0, show_default=True,
+                        help="Controller address, DIP switches 1-4 (MS176E §3.1.3).")
+_BAUD = click.option("--baud", type=click.IntRange(300, 921_600), default=9600, show_default=True,
+                     help="Baud rate, DIP switches 5-6.")
+_TIMEOUT = click.option("--timeout", type=click.FloatRange(0.05, 60), default=1.0,
+                        show_default=True, help="Seconds to wait for each reply.")
+
+
+def _timing(timeout: float):
+    from mercmac.upload.transport import Timing
+
+    return Timing(timeout=timeout, settle=min(0.25, timeout))
+
+
+@click.command()
+@click.argument("port")
+@click.argument("file", type=click.Path(dir_okay=False, allow_dash=True))
+@_ADDRESS
+@_BAUD
+@click.option("--dry-run", is_flag=True, help="Read back and show the exact bytes; write nothing.")
+@click.option("--backup", type=click.Path(dir_okay=False, writable=True),
+              help="Where to save what the controller holds (default: a timestamped file "
+                   "in the per-user data directory).")
+@click.option("--erase-unused", is_flag=True, help="Remove stored macros the file does not define.")
+@click.option("--reset", is_flag=True, help="Send RT afterwards so that macro 0 starts.")
+@click.option("--force", is_flag=True, help="Flash even if the controller is not the file's target.")
+@click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
+@_TIMEOUT
+def flash(port, file, address, baud, dry_run, backup, erase_unused, reset, force, target,
+          timeout) -> None:
+    """Upload FILE to the controller on PORT: back up, write what differs, verify.
+
+    PORT is anything pyserial opens: COM3, /dev/ttyUSB0, a pty path,
+    socket://host:port. Exit 0 only when every written macro reads back right.
+    """
+    def work() -> int:
+        from pathlib import Path
+
+        from mercmac.render import upload as view
+        from mercmac.render.console import write_lines
+        from mercmac.upload import flasher, session
+        from mercmac.upload.errors import FlashInterrupted
+
+        program = _compile(file, target)
+        options = flasher.FlashOptions(erase_unused, dry_run, reset, Path(backup) if backup else None)
+        with session.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
+            try:
+                who = session.identify(c)
+                if program.target is None:
+                    program = _compile(file, who.version.model)
+                warning = session.check_model(who, program.target, file, force=force)
+                write_lines(view.identity_lines(port, address, who, warning))
+            except KeyboardInterrupt:
+                raise FlashInterrupted("interrupted before the first write; nothing was written") from None
+            with view.FlashProgress() as progress:
+                result = flasher.flash(c, who, program, options, progress)
+        if dry_run:
+            write_lines(view.dry_run_lines(result, address, baud))
+        write_lines(view.flash_summary(result, port))
+        return EXIT_OK
+
+    run_guarded(work)
+
+
+def _compile(file: str, target: str | None):
+    """The program of FILE, or a refusal with its diagnostics on standard error."""
+    from mercmac.compiler import compile_file
+    from mercmac.render import diagnostics as render
+    from mercmac.upload.errors import Refused
+
+    result = compile_file(file, target=target)
+    if result.report.has_errors or result.program is None:
+        render.write_text(result.report.items, {result.source.name: result.source}, 1,
+                          click.get_text_stream("stderr"))
+        against = f" for the {target}" if target else ""
+        raise Refused(f"{file} has errors{against}; nothing was flashed")
+    return result.program
+
+
+@click.command()
+@click.argument("port")
+@click.option("-o", "--output", type=click.Path(dir_okay=False, allow_dash=True),
+              help="Write the .mcm file here instead of standard output.")
+@_ADDRESS
+@_BAUD
+@_TIMEOUT
+def pull(port, output, address, baud, timeout) -> None:
+    """Read every macro of the controller on PORT into a .mcm file.
+
+    The file passes `mercmac check`, and `mercmac flash` puts back exactly
+    these macros. Reading stops a running macro (MS176E §3.8.3).
+    """
+    def work() -> int:
+        from mercmac.render import upload as view
+        from mercmac.render.console import write_lines
+        from mercmac.upload import backup, session, survey
+
+        with session.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
+            pulled = survey.pull(c)
+        to_file = output and output != "-"
+        if to_file:
+            from pathlib import Path
+
+            try:
+                backup.save(pulled.text, Path(output))
+            except backup.BackupError as e:
+                raise UsageError(str(e)) from None
+        else:
+            click.echo(pulled.text, nl=False)
+        err = click.get_text_stream("stderr")
+        write_lines(view.identity_lines(port, address, pulled.identity), err)
+        write_lines(view.pulled_lines(pulled, port, address, output if to_file else None), err)
+        return EXIT_OK
+
+    run_guarded(work)
+
+
+@click.command()
+def ports() -> None:
+    """List serial ports; PI USB devices (vendor 0x1A72) are marked as likely Mercury."""
+    def work() -> int:
+        from mercmac.render import upload as view
+        from mercmac.render.console import write_lines
+        from mercmac.upload import survey
+
+        write_lines(view.ports_lines(survey.list_ports()))
+        return EXIT_OK
+
+    run_guarded(work)
+
+
+@click.command()
+@click.argument("port")
+@_BAUD
+@click.option("--timeout", type=click.FloatRange(0.05, 60), default=0.3, show_default=True,
+              help="Seconds to wait at each address.")
+@click.option("--stop", is_flag=True, help="Also identify controllers that run a macro (stops it).")
+def scan(port, baud, timeout, stop) -> None:
+    """Which addresses 0-15 answer on PORT, with model and firmware (daisy chains, MS176E §3.2).
+
+    Probes with `%`, which does not stop a running macro; such controllers
+    are listed without firmware unless --stop is given. Exit 1 if none answers.
+    """
+    def work() -> int:
+        from mercmac.render import upload as view
+        from mercmac.render.console import write_lines
+        from mercmac.upload import session, survey
+
+        with session.open_controller(port, 0, baud=baud, timing=_timing(timeout)) as c:
+            found = survey.scan(c.transport, stop=stop)
+        write_lines(view.scan_lines(found, port))
+        return EXIT_OK if found else EXIT_FAILED
+
+    run_guarded(work)
+
+
+@click.command()
+@click.option("--target", type=MODEL_CHOICE, default="C-863", show_default=True,
+              help="Model the virtual controller reports.")
+@_ADDRESS
+@click.option("--state", type=click.Path(dir_okay=False),
+              help="Keep the macros (flash memory) in this file across runs.")
+@click.option("--firmware", default="2.30", show_default=True,
+              help="Firmware version VE reports; 1.xx drops lines typed slower than 20 ms a character.")
+def emulate(target, address, state, firmware) -> None:
+    """Serve a virtual controller on a pseudo-terminal and print the path to open.
+
+    Try `mercmac flash PATH FILE` without hardware; Ctrl-C stops it.
+    """
+    def work() -> int:
+        from pathlib import Path
+
+        from mercmac.upload.emulator import VirtualController
+        from mercmac.upload.ptyserver import PtyServer
+
+        vc = VirtualController(target.upper(), address, firmware=firmware,
+                               state=Path(state) if state else None)
+        try:
+            server = PtyServer(vc)
+        except OSError as e:
+            raise UsageError(f"cannot create a pseudo-terminal: {e}") from None
+        kept = f", macros kept in {state}" if state else ""
+        click.echo(f"virtual {vc.model} (firmware {firmware}) at address {address}{kept}")
+        click.echo(server.path)
+        try:
+            server.serve_forever()
+        except KeyboardInterrupt:
+            pass
+        finally:
+            server.close()
+        return EXIT_OK
+
+    run_guarded(work)
+
+
+COMMANDS = [flash, pull, ports, scan, emulate]
