@@ -89,11 +89,28 @@ def _returns(program: Program, callee: Macro, remainder: list[Op]) -> bool:
         return True
     if any(o.mnemonic in _CONDITIONS for o in callee.ops[ems[0]:]):
         return False  # an XN/XF after an inner call ends the program, not the callee
-    last = callee.ops[-1]
-    if last.role == "goto":
-        return True  # a mode switch: the caller's rest is abandoned on purpose
-    continues = len(remainder) == 1 and remainder[0].mnemonic == "EM"
-    return continues and last.mnemonic == "EM" and last.arg == remainder[0].arg
+    then = remainder[0].arg if len(remainder) == 1 and remainder[0].mnemonic == "EM" else None
+    return _ends_on_purpose(program, callee, then)
+
+
+def _ends_on_purpose(program: Program, macro: Macro, then: int | None) -> bool:
+    """Whether every run of `macro`, followed through tail EMs into compiler-made
+    continuations, ends in a goto (a mode switch: the caller's rest is abandoned on
+    purpose) or in a tail EM to `then`, the caller's own last step."""
+    seen = set()
+    while macro.ops and macro.slot not in seen:
+        last = macro.ops[-1]
+        if last.mnemonic != "EM":
+            return False
+        if last.role == "goto" or (then is not None and last.arg == then):
+            return True
+        if last.role != "continue" or last.arg not in program.macros:
+            return False
+        seen.add(macro.slot)
+        macro = program.macros[last.arg]
+        if any(o.mnemonic in _CONDITIONS for o in macro.ops):
+            return False
+    return False
 
 
 def _advice(op: Op, callee: Macro) -> str:

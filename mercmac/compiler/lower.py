@@ -40,10 +40,14 @@ class _Em:
 
 
 def _calls_on(ops: list) -> bool:
-    """True when a block would lose its caller's return point and not end in a goto."""
-    ems = [op for op in ops if _is_em(op)]
-    return bool(ems) and any(e.role != "goto" for e in ems) and not (
-        _is_em(ops[-1]) and ops[-1].role == "goto")
+    """Whether a called block takes its caller's return point and may then end
+    other than through a goto (after an inner call, an XN/XF exit ends the program)."""
+    calls = [i for i, op in enumerate(ops) if _is_em(op) and op.role != "goto"]
+    if not calls:
+        return False
+    ends_in_goto = _is_em(ops[-1]) and ops[-1].role == "goto"
+    exits_after = any(isinstance(op, Op) and op.mnemonic in ("XN", "XF") for op in ops[calls[0]:])
+    return exits_after or not ends_in_goto
 
 
 def _is_em(op) -> bool:
@@ -65,9 +69,10 @@ class _Lowerer:
         return self.new(f"{owner.name}.{kind}@{span.line}", kind, span)
 
     # -- statements --------------------------------------------------------
-    def seq(self, stmts: tuple, owner: _Macro, *, at_start: bool, loop: bool) -> list:
+    def seq(self, stmts: tuple, owner: _Macro, *, at_start: bool, loop: bool,
+            cont: _Macro | None = None) -> list:
         """The ops of a statement sequence that runs to the end of `owner`'s line
-        (or, inside a repeat/every body, up to the loop's RP)."""
+        (inside a repeat/every body: up to the loop's RP), then tail-EMs `cont`."""
         out: list = []
         for i, stmt in enumerate(stmts):
             rest = stmts[i + 1:]
@@ -80,31 +85,36 @@ class _Lowerer:
                 if target is not None:
                     out.append(_Em(target, stmt.span, "call" if isinstance(stmt, ast.Call) else "goto"))
             elif isinstance(stmt, ast.Repeat) and self.count(stmt) == 1:
-                return out + self.seq(stmt.body + rest, owner, at_start=whole, loop=loop)
-            elif isinstance(stmt, ast.When) and not rest and not loop:
+                return out + self.seq(stmt.body + rest, owner, at_start=whole, loop=loop, cont=cont)
+            elif isinstance(stmt, ast.When) and not rest and not loop and cont is None:
                 return out + self.conditions(stmt) + self.seq(stmt.body, owner, at_start=False, loop=False)
             elif isinstance(stmt, (ast.Repeat, ast.Every)) and whole:
-                return out + self.loop_ops(stmt, owner)
+                return out + self.loop_ops(stmt, owner) + _tail(cont, stmt.span)
             else:
-                block = self.hoist(stmt, owner)
+                block = self.helper(owner, type(stmt).__name__.lower(), stmt.span)
                 out.append(_Em(block, stmt.span, "hoist"))
-                if rest and not loop and _calls_on(block.ops):
-                    after = self.helper(owner, "rest", rest[0].span)
-                    after.ops = self.seq(rest, after, at_start=True, loop=False)
-                    block.ops.append(_Em(after, rest[0].span, "continue"))
-                    out.append(_Em(after, rest[0].span, "continue"))
-                    return out
-        return out
+                mark = len(self.order)
+                block.ops = self.block_ops(stmt, block, None)
+                if (rest or cont) and not loop and _calls_on(block.ops):
+                    # The block takes the return point: what follows it continues in
+                    # a macro that both the block and this line reach by a tail EM.
+                    del self.order[mark:]
+                    after = cont
+                    if rest:
+                        after = self.helper(owner, "rest", rest[0].span)
+                        after.ops = self.seq(rest, after, at_start=True, loop=False, cont=cont)
+                    block.ops = self.block_ops(stmt, block, after)
+                    return out + _tail(after, stmt.span)
+        if out and isinstance(out[-1], _Em) and out[-1].role == "goto":
+            return out
+        return out + _tail(cont, stmts[-1].span if stmts else owner.span)
 
-    def hoist(self, stmt, owner: _Macro) -> _Macro:
-        """A when/repeat/every block in a macro of its own."""
-        kind = type(stmt).__name__.lower()
-        block = self.helper(owner, kind, stmt.span)
+    def block_ops(self, stmt, block: _Macro, cont: _Macro | None) -> list:
+        """A hoisted when/repeat/every block's ops, ending with a tail EM to `cont`."""
         if isinstance(stmt, ast.When):
-            block.ops = self.conditions(stmt) + self.seq(stmt.body, block, at_start=False, loop=False)
-        else:
-            block.ops = self.loop_ops(stmt, block)
-        return block
+            return self.conditions(stmt) + self.seq(stmt.body, block, at_start=False, loop=False,
+                                                    cont=cont)
+        return self.loop_ops(stmt, block) + _tail(cont, stmt.span)
 
     def loop_ops(self, stmt, owner: _Macro) -> list:
         body = self.seq(stmt.body, owner, at_start=False, loop=True)
@@ -166,7 +176,8 @@ class _Lowerer:
         for m in self.order:
             if m.slot is not None:
                 taken[m.slot] = m  # duplicates were reported; the last wins as on the controller
-        free = (s for s in SLOTS if s not in taken)
+        # Slot 0 is the autostart macro: never given to a macro that did not ask for it.
+        free = (s for s in SLOTS if s and s not in taken)
         for m in self.order:
             if m.slot is None:
                 m.slot = next(free, None)
@@ -177,6 +188,10 @@ class _Lowerer:
                     continue
                 taken[m.slot] = m
         return taken
+
+
+def _tail(cont: _Macro | None, span: Span) -> list:
+    return [] if cont is None else [_Em(cont, span, "continue")]
 
 
 def _part_number(m: _Macro) -> int:

@@ -1,0 +1,122 @@
+"""Properties of the compiler on generated programs and mangled input.
+
+- Random well-formed high-level programs lower to MD strings that obey every
+  firmware limit, and run on a model of the firmware (SPEC §3) exactly as the
+  structured program means, for every combination of held inputs.
+- Mangled input never raises: every failure is a diagnostic.
+"""
+from __future__ import annotations
+
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from conftest import EXAMPLES, compile_text
+from mercmac.compiler.build import build
+from mercmac.compiler.checks import check_module
+from mercmac.compiler.parse import parse
+from mercmac.compiler.program import MAX_COMMANDS
+from mercmac.diagnostics import Report
+from semantics import firmware_trace, high_level_trace
+
+EFFECTS = st.one_of(
+    st.integers(-50, 50).map(lambda n: f"MR {n}"),
+    st.integers(1, 4).map(lambda n: f"CN {n}"),
+    st.integers(1, 4).map(lambda n: f"CF {n}"),
+    st.integers(0, 15).map(lambda n: f"CP {n}"),
+    st.integers(1, 9).map(lambda n: f"SV {n}000"),
+    st.integers(1, 9).map(lambda n: f"WA {n}"),
+    st.just("TP"),
+)
+CONDITION = st.tuples(st.booleans(), st.integers(1, 6)).map(
+    lambda c: ("not " if c[0] else "") + str(c[1]))
+
+
+@st.composite
+def block(draw, depth: int, leaves: int, modes: int, in_loop: bool, nested: bool):
+    """A statement list; calls only to leaf macros, never from blocks nested in a loop."""
+    stmts = []
+    for _ in range(draw(st.integers(0 if depth else 1, 4))):
+        options = ["effect", "effect"]
+        if leaves and not (in_loop and nested):
+            options.append("call")
+        if depth < 2:
+            options += ["when", "repeat"] + ([] if in_loop else ["every"])
+        kind = draw(st.sampled_from(options))
+        if kind == "effect":
+            stmts.append(draw(EFFECTS))
+        elif kind == "call":
+            stmts.append(f"call leaf{draw(st.integers(0, leaves - 1))}")
+        elif kind == "when":
+            conds = " and ".join(draw(st.lists(CONDITION, min_size=1, max_size=2)))
+            body = draw(block(depth + 1, leaves, modes, in_loop, True))
+            stmts.append(f"when {conds} {{ {', '.join(body)} }}")
+        elif kind == "repeat":
+            body = draw(block(depth + 1, leaves, modes, True, in_loop))
+            stmts.append(f"repeat {draw(st.integers(1, 3))} {{ {', '.join(body)} }}")
+        else:
+            body = draw(block(depth + 1, leaves, modes, True, in_loop))
+            stmts.append(f"every {draw(st.integers(0, 30))}ms {{ {', '.join(body)} }}")
+    if modes and draw(st.booleans()) and not in_loop:
+        stmts.append(f"goto mode{draw(st.integers(0, modes - 1))}")
+    return stmts
+
+
+@st.composite
+def programs(draw):
+    leaves = draw(st.integers(0, 2))
+    modes = draw(st.integers(0, 2))
+    text = []
+    for i in range(leaves):
+        text.append(f"macro leaf{i} {{ {', '.join(draw(st.lists(EFFECTS, min_size=1, max_size=8)))} }}")
+    for i in range(modes):
+        text.append(f"macro mode{i} {{\n  " + "\n  ".join(draw(block(0, leaves, modes, False, False))) + "\n}")
+    text.append("autostart {\n  " + "\n  ".join(draw(block(0, leaves, modes, False, False))) + "\n}")
+    return "\n".join(text) + "\n"
+
+
+def _stages(text):
+    report = Report("gen.mcm")
+    module = build(parse(text, report))
+    return module, check_module(module, report, None)
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(programs())
+def test_lowered_programs_obey_the_firmware_and_keep_the_meaning(text):
+    result = compile_text(text)
+    errors = [d for d in result.report.items if d.severity == 0]
+    if errors:  # only the slot budget may legitimately run out
+        assert {d.rule.name for d in errors} == {"slot-range"}, (text, [d.message for d in errors])
+        return
+    program = result.program
+    assert set(program.macros) <= set(range(32))
+    for m in program.macros.values():
+        assert len(m.ops) <= MAX_COMMANDS, (text, m.md)
+    stored = {slot: [(op.mnemonic, op.arg) for op in m.ops] for slot, m in program.macros.items()}
+    module, env = _stages(text)
+    for mask in range(0, 64, 7):
+        inputs = {n for n in range(1, 7) if mask >> (n - 1) & 1}
+        assert firmware_trace(stored, inputs) == high_level_trace(module, env, inputs), (text, inputs)
+
+
+NOISE = st.sampled_from(list("[]{},;@=-+?0123456789 \t\nMCEWXNFRPSVTabcdefghijklmnopqrstuvwxyz/\u2122"))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.sampled_from(sorted(EXAMPLES.glob("*.mcm"))), st.data())
+def test_mangled_input_never_raises(path, data):
+    text = path.read_text(encoding="utf-8")
+    for _ in range(data.draw(st.integers(1, 6))):
+        at = data.draw(st.integers(0, len(text)))
+        cut = data.draw(st.integers(0, 3))
+        text = text[:at] + "".join(data.draw(st.lists(NOISE, max_size=4))) + text[at + cut:]
+    result = compile_text(text)
+    for d in result.report.items:
+        assert d.span.line >= 1 and d.span.column >= 1 and d.message
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(max_size=200))
+def test_arbitrary_text_never_raises(text):
+    result = compile_text(text)
+    assert result.program is not None or result.report.has_errors
