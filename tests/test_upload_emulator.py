@@ -46,6 +46,16 @@ def raw_port(server):
         port.close()
 
 
+def eventually(server, check, seconds: float = 1.0) -> bool:
+    """Whether check(controller) becomes true: the emulator reads bytes in its own thread."""
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if server.call(check):
+            return True
+        time.sleep(0.005)
+    return False
+
+
 def read_for(port, seconds: float = 0.15) -> bytes:
     end, data = time.monotonic() + seconds, b""
     while time.monotonic() < end:

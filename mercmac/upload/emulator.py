@@ -44,6 +44,7 @@ class Faults:
     silent: bool = False  # nothing answers at all
     garble: bool = False  # replies arrive mangled, as at a wrong baud rate
     char_gap: bool | None = None  # enforce the 20 ms gap; None = as the firmware version says
+    md_delay: float = 0.0  # seconds a flash write keeps the controller from reading on
 
 
 class VirtualController:
@@ -57,6 +58,8 @@ class VirtualController:
         self.state = state
         self.lines: list[str] = []  # every command line received, for tests and benchmarks
         self.md_count = 0
+        self.busy_until = 0.0  # while storing a macro, further bytes wait in the input buffer
+        self._held = bytearray()
         self.vanished = False
         self.selected = False
         self._out = bytearray()
@@ -64,6 +67,7 @@ class VirtualController:
         self._last_char_at = 0.0
         self._last_line: str | None = None
         self._awaiting_address = False
+        self._now = 0.0
         self.machine = Machine(model=model, options=Options(address=address),
                                on_report=lambda t_ms, text: self.report(text))
         stored = load_state(state) if state and state.exists() else dict(macros or {})
@@ -95,6 +99,10 @@ class VirtualController:
         """Let running macros advance to wall time `now` (seconds since power-on)."""
         self.machine.run_until(now * 1000)
         self._self_select()
+        self._now = now
+        while self._held and now >= self.busy_until and not self.vanished:
+            byte = self._held.pop(0)
+            self._byte(byte, now)
 
     def take(self) -> bytes:
         """Bytes waiting to go to the host."""
@@ -106,11 +114,8 @@ class VirtualController:
 
     def receive(self, data: bytes, now: float) -> None:
         """Bytes from the host, one at a time, as the firmware sees them."""
+        self._held += data  # held while a macro is being stored (Faults.md_delay)
         self.tick(now)
-        for byte in data:
-            if self.vanished:
-                return
-            self._byte(byte, now)
 
     def report(self, text: str) -> None:
         """Send a report if selected; deselected controllers stay silent (MS176E §5.1, §5.6)."""
@@ -216,6 +221,7 @@ class VirtualController:
         else:
             self.machine.define(slot, ops)
             self._save()
+            self.busy_until = self._now + self.faults.md_delay
         if self.faults.vanish_after_md is not None and self.md_count >= self.faults.vanish_after_md:
             self.vanished = True
 

@@ -108,6 +108,7 @@ class _Run:
         self.believed = dict(plan.before)
         self.done: list[Step] = []
         self.current: Step | None = None
+        self.verify_failed = False
 
     def execute(self) -> None:
         total = len(self.plan.steps)
@@ -124,6 +125,7 @@ class _Run:
             raise FlashInterrupted(self._report("interrupted (Ctrl-C)", alive=True),
                                    hint=self._hint()) from None
         except _Mismatch as e:
+            self.verify_failed = True
             raise FlashFailed(self._report(str(e), alive=True), hint=self._hint()) from None
         except ControllerError as e:
             alive = not isinstance(e, LinkLost)
@@ -185,8 +187,10 @@ class _Run:
         pending = self.plan.steps[len(self.done) + (current is not None):]
         lines = [f"flash stopped: {cause}",
                  "  written and verified: " + (_names(self.done) or "nothing")]
-        if current:
-            lines.append(f"  in progress, state unknown: {current.action.value} {current.name}")
+        if current and self.verify_failed:
+            lines.append(f"  failed verification: {_names([current])}")
+        elif current:
+            lines.append(f"  in progress, state unknown: {_names([current])}")
         lines += ["  not written: " + (_names(pending) or "nothing"),
                   "  macro 0: " + zero,
                   f"  backup of the controller as it was: {self.result.backup}"]
@@ -241,8 +245,9 @@ class _Mismatch(Exception):
 
 
 def _names(steps: list[Step]) -> str:
-    return ", ".join(f"{s.name}" + (" (erase)" if s.action is not Action.WRITE else "")
-                     for s in steps)
+    """'MC00 (autostart removed), MC05, MC09 (erased)'."""
+    tags = {Action.WRITE: "", Action.PARK: " (autostart removed)", Action.ERASE: " (erased)"}
+    return ", ".join(f"{s.name}{tags[s.action]}" for s in steps)
 
 
 def _cause(e: ControllerError) -> str:
