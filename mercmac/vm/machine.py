@@ -151,6 +151,11 @@ class Machine:
         ip = self.last_rp.get(slot)
         return self.counters.get(slot, {}).get(ip, 0)
 
+    def next_event_ms(self) -> float:
+        """When the next hardware event or command is due; inf when nothing will happen."""
+        t_ins = self.wake if self.chunk is not None and self.block is None else INF
+        return min(self._next_hardware(), t_ins) / 1000
+
     def set_input(self, n: int, on: bool) -> None:
         """Set input line n (1-6) now."""
         if self.inputs.set(n, on):

@@ -27,7 +27,7 @@ class Folded:
 class Recorder:
     """Collects events; pass its `on_event` to a Machine."""
 
-    def __init__(self, *, macro_changes: bool = False):
+    def __init__(self):
         self.reports: list[ev.Reported] = []
         self.outputs: list[ev.OutputsChanged] = []
         self.hazards: list[ev.HazardFound] = []
@@ -35,7 +35,6 @@ class Recorder:
         self.trace: list[ev.Executed] = []
         self.dropped = {"reports": 0, "outputs": 0, "timeline": 0, "trace": 0}
         self.ended_at: int | None = None
-        self.macro_changes: list[tuple[int, int | None]] | None = [] if macro_changes else None
         self._folds: dict[tuple, Folded] = {}
 
     def on_event(self, event) -> None:
@@ -63,9 +62,6 @@ class Recorder:
             self.dropped[what] += 1
 
     def _flow(self, event: ev.MacroEntered | ev.MacroLeft) -> None:
-        if self.macro_changes is not None:
-            slot = event.slot if isinstance(event, ev.MacroEntered) else event.back_slot
-            self.macro_changes.append((event.t, slot))
         if isinstance(event, ev.MacroEntered):
             self.ended_at = None
         key = (type(event), event.slot, getattr(event, "why", ""))

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable
+from typing import IO, Iterable
 
 from mercmac.compiler.program import Program
 from mercmac.timespec import Press
@@ -42,10 +42,9 @@ def schedule(machine: Machine, presses: Iterable[Press]) -> None:
 
 
 def machine_for(program: Program, *, model: str | None = None, cycle_ms: float = 1.0,
-                options: Options | None = None, trace: bool = False,
-                macro_changes: bool = False) -> tuple[Machine, Recorder]:
+                options: Options | None = None, trace: bool = False) -> tuple[Machine, Recorder]:
     """A machine with a recorder attached, not yet powered on."""
-    record = Recorder(macro_changes=macro_changes)
+    record = Recorder()
     machine = Machine(program, model=model, cycle_ms=cycle_ms, options=options,
                       on_event=record.on_event, trace=trace)
     return machine, record
@@ -53,11 +52,19 @@ def machine_for(program: Program, *, model: str | None = None, cycle_ms: float =
 
 def simulate(program: Program, *, presses: Iterable[Press] = (), until_ms: int = DEFAULT_UNTIL_MS,
              model: str | None = None, cycle_ms: float = 1.0, options: Options | None = None,
-             trace: bool = False, macro_changes: bool = False) -> Run:
+             trace: bool = False, vcd: IO[str] | None = None) -> Run:
     """Power on at t = 0 (macro 0 starts, SPEC §3 Power-on) and run to until_ms."""
     machine, record = machine_for(program, model=model, cycle_ms=cycle_ms, options=options,
-                                  trace=trace, macro_changes=macro_changes)
+                                  trace=trace)
+    dump = None
+    if vcd is not None:
+        from mercmac.vm.vcd import VcdObserver
+
+        dump = VcdObserver(vcd, record.on_event)
+        machine.on_event = dump.on_event
     schedule(machine, presses)
     machine.power_on()
     machine.run_until(until_ms)
+    if dump is not None:
+        dump.close(round(until_ms * 1000))
     return Run(machine, record, until_ms)

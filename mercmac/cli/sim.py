@@ -1,0 +1,57 @@
+"""`mercmac sim`: options in, the simulator library does the work (SPEC §5).
+
+Heavy modules (the VM, rich, pyvcd) are imported inside the command, so that
+`mercmac check`, which imports this module, starts fast.
+"""
+from __future__ import annotations
+
+import click
+
+from mercmac.cli.common import MODEL_CHOICE, run_guarded
+from mercmac.errors import EXIT_FAILED, EXIT_OK
+
+
+@click.command()
+@click.argument("file", type=click.Path(dir_okay=False, allow_dash=True))
+@click.option("--buttons", default="", metavar="SPEC",
+              help='Button script: "1@0-2s,2+3@5s-5.2s" (input B held from T1 to T2, or from T1 on).')
+@click.option("--until", "until", default=None, metavar="DURATION",
+              help="How long to simulate: 500ms, 10s, 2h, 1500d.  [default: 10s]")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
+              show_default=True, help="A timeline for people or JSON for programs.")
+@click.option("--trace", is_flag=True, help="Show every executed instruction, disassembled.")
+@click.option("--vcd", type=click.Path(dir_okay=False), metavar="OUT",
+              help="Write a Value Change Dump (GTKWave, Surfer) to OUT.")
+@click.option("--interactive", is_flag=True, help="A live pushbutton box: keys 1-4, q quits.")
+@click.option("--speed", type=float, default=1.0, show_default=True,
+              help="Simulated seconds per wall-clock second in --interactive.")
+@click.option("--scenario", type=click.Path(dir_okay=False), metavar="FILE.toml",
+              help="Timed button steps and expectations; exit 1 on the first that fails.")
+@click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
+@click.option("--cycle", type=float, default=1.0, show_default=True, metavar="MS",
+              help="Time one executed command takes.")
+@click.option("--servo-off", is_flag=True,
+              help="Start with the servo off (a real controller needs MN; the manual's examples never send it).")
+@click.option("--reference-at", type=int, default=0, show_default=True, metavar="POS",
+              help="Position of the reference switch that FE searches for.")
+@click.option("--hard-limits", default=None, metavar="NEG,POS",
+              help="Positions of the limit switches, e.g. -200000,200000 (default: none).")
+def sim(file, buttons, until, fmt, trace, vcd, interactive, speed, scenario, target, cycle,
+        servo_off, reference_at, hard_limits) -> None:
+    """Simulate FILE on a virtual controller with a scripted pushbutton box.
+
+    Macro 0 starts at power-on (t = 0). A file with errors is not simulated:
+    its diagnostics are shown and the exit code is 1.
+    """
+    def work() -> int:
+        from mercmac.vm import session
+
+        request = session.Request(
+            file=file, buttons=buttons, until=until, fmt=fmt, trace=trace, vcd=vcd,
+            interactive=interactive, speed=speed, scenario=scenario, target=target,
+            cycle_ms=cycle, servo_off=servo_off, reference_at=reference_at,
+            hard_limits=hard_limits)
+        return EXIT_OK if session.run(request) else EXIT_FAILED
+
+    run_guarded(work)
+

@@ -1,0 +1,79 @@
+"""`sim --interactive`: a live C-170.PB pushbutton box in the terminal (issue 3).
+
+Keys 1-4 press and release the buttons (5 and 6: joystick and its button),
+q quits. Simulated time follows the wall clock times the speed factor.
+"""
+from __future__ import annotations
+
+import os
+import select
+import sys
+import time
+from typing import IO
+
+from mercmac.errors import UsageError
+from mercmac.render import sim as render
+from mercmac.render.console import write_lines
+from mercmac.vm import events as ev
+from mercmac.vm.machine import Machine
+
+TICK_S = 0.05  # redraw period
+HELP = "keys 1-4: press/release a button (5, 6: joystick, joystick button) - q: quit"
+CLEAR = "\r\x1b[K"  # carriage return, erase to the end of the line (ECMA-48 EL)
+SHOWN = (ev.InputChanged, ev.OutputsChanged, ev.Reported, ev.HazardFound, ev.MoveStarted,
+         ev.MoveEnded, ev.HomeDefined, ev.ProgramEnded)
+
+
+def run(machine: Machine, *, speed: float = 1.0, stdin: IO | None = None,
+        stdout: IO[str] | None = None) -> int:
+    """Run the box until q; the terminal is put back as it was, whatever happens."""
+    stdin, stdout = stdin or sys.stdin, stdout or sys.stdout
+    if not stdin.isatty():
+        raise UsageError("--interactive needs a terminal on standard input")
+    if speed <= 0:
+        raise UsageError("--speed must be greater than 0")
+    import termios
+    import tty
+
+    fd = stdin.fileno()
+    saved = termios.tcgetattr(fd)
+    tty.setcbreak(fd)  # keys arrive one by one, without Enter and without echo
+    try:
+        return _loop(machine, speed, fd, stdout)
+    finally:
+        termios.tcsetattr(fd, termios.TCSADRAIN, saved)
+        stdout.write("\n")
+        stdout.flush()
+
+
+def _loop(machine: Machine, speed: float, fd: int, out: IO[str]) -> int:
+    pending: list = []
+    machine.on_event = pending.append
+    out.write(f"{HELP}  (speed x{speed:g})\n")
+    machine.power_on()
+    start = time.monotonic()
+    while True:
+        ready, _, _ = select.select([fd], [], [], TICK_S)
+        machine.run_until((time.monotonic() - start) * 1000 * speed)
+        for key in os.read(fd, 64).decode(errors="ignore") if ready else "":
+            if key in "qQ":
+                _show(pending, machine, out)
+                return 0
+            if key in "123456":
+                n = int(key)
+                machine.set_input(n, not machine.inputs[n])
+        _show(pending, machine, out)
+
+
+def _show(pending: list, machine: Machine, out: IO[str]) -> None:
+    """Print what happened since the last tick above the status line, then redraw it."""
+    lines = [render.event_line(e) for e in pending if isinstance(e, SHOWN)]
+    pending.clear()
+    if lines:
+        out.write(CLEAR)
+        write_lines(lines, out)
+    label = machine.chunk.label if machine.chunk is not None else "direct mode"
+    out.write(CLEAR + render.live_status(machine.clock.now, machine.outputs_pattern(),
+                                         machine.inputs.state, machine.position(),
+                                         machine.target, label))
+    out.flush()
