@@ -5,6 +5,8 @@ bodies so that `mercmac check` starts fast.
 """
 from __future__ import annotations
 
+import sys
+
 import click
 
 from mercmac.cli.common import MODEL_CHOICE, run_guarded
@@ -83,7 +85,7 @@ def _compile(file: str, target: str | None):
     result = compile_file(file, target=target)
     if result.report.has_errors or result.program is None:
         render.write_text(result.report.items, {result.source.name: result.source}, 1,
-                          click.get_text_stream("stderr"))
+                          sys.stderr)
         against = f" for the {target}" if target else ""
         raise Refused(f"{file} has errors{against}; nothing was flashed")
     return result.program
@@ -119,7 +121,7 @@ def pull(port, output, address, baud, timeout) -> None:
                 raise UsageError(str(e)) from None
         else:
             click.echo(pulled.text, nl=False)
-        err = click.get_text_stream("stderr")
+        err = sys.stderr
         write_lines(view.identity_lines(port, address, pulled.identity), err)
         write_lines(view.pulled_lines(pulled, port, address, output if to_file else None), err)
         return EXIT_OK

@@ -100,6 +100,8 @@ def dry_run_lines(result, address: int, baud: int) -> list[Line]:
     """Every byte a real flash would now send, and what for."""
     from mercmac.upload.protocol import show
 
+    if result.plan.changes_nothing:
+        return [[("nothing to send: ", "bold"), ("the controller already holds this program", "")]]
     wire = result.wire(address)
     lines: list[Line] = [[("bytes a flash would send after the read-back:", "bold")]]
     for data, purpose in wire:

@@ -68,9 +68,10 @@ def save(text: str, path: Path) -> Path:
 
 
 def _port_tag(port: str) -> str:
-    """'/dev/ttyUSB0' -> 'ttyUSB0', 'socket://lab:4001' -> 'lab-4001': safe in a file name."""
-    tail = re.split(r"[/\\]+", port.split("://", 1)[-1].rstrip("/\\"))[-1] or "port"
-    return re.sub(r"[^A-Za-z0-9_.-]+", "-", tail).strip("-") or "port"
+    """'/dev/ttyUSB0' -> 'ttyUSB0', '/dev/pts/3' -> 'pts-3', 'socket://lab:4001' -> 'lab-4001'."""
+    tail = port.split("://", 1)[-1]
+    tail = re.sub(r"^(/dev/|\\\\\.\\)", "", tail)
+    return re.sub(r"[^A-Za-z0-9_.]+", "-", tail).strip("-") or "port"
 
 
 def _comment_safe(text: str) -> str:

@@ -60,7 +60,7 @@ class FlashResult:
         """The exact bytes a flash sends after reading back, with what each is for."""
         out = [(protocol.select(address), "address selection (0x01 + address)")]
         for step in self.plan.steps:
-            out.append((protocol.command(step.wire), f"{step.action.value} {step.name}"))
+            out.append((protocol.command(step.wire), step.describe))
             out.append((protocol.command(step.readback), f"read back {step.name}"))
         if self.reset:
             out.append((protocol.command("RT"), "reset: macro 0 starts"))
@@ -115,12 +115,11 @@ class _Run:
         try:
             for i, step in enumerate(self.plan.steps):
                 self.current = step
-                self.notify(Event("step", f"{step.action.value} {step.name}", i, total))
+                self.notify(Event("step", step.describe, i, total))
                 self._apply(step)
                 self.done.append(step)
                 self.current = None
-                self.notify(Event("verified", f"{step.action.value} {step.name}: verified",
-                                  i + 1, total))
+                self.notify(Event("verified", f"{step.describe}: verified", i + 1, total))
         except KeyboardInterrupt:
             raise FlashInterrupted(self._report("interrupted (Ctrl-C)", alive=True),
                                    hint=self._hint()) from None

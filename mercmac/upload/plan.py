@@ -16,7 +16,7 @@ from mercmac.upload import protocol
 class Action(str, Enum):
     """What one step does to one slot."""
 
-    PARK = "remove autostart"  # RZ before anything else; macro 0 comes back last
+    PARK = "park"  # RZ before anything else; macro 0 comes back last
     WRITE = "write"  # MDn,... then read back
     ERASE = "erase"  # RMn / RZ then read back
 
@@ -36,6 +36,13 @@ class Step:
         if self.action is Action.WRITE:
             return f"MD{self.slot},{self.line}"
         return "RZ" if self.slot == 0 else f"RM{self.slot}"
+
+    @property
+    def describe(self) -> str:
+        """'write MC05', 'erase MC07', 'remove autostart MC00 until the end'."""
+        if self.action is Action.PARK:
+            return f"remove {self.name} (autostart) until the end"
+        return f"{self.action.value} {self.name}"
 
     @property
     def expected(self) -> str | None:
