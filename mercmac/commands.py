@@ -6,8 +6,8 @@ lists mnemonics.  Page numbers are those of the manual's §6.2 table.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from enum import Enum
+from typing import NamedTuple
 
 C663 = "C-663"
 C863 = "C-863"
@@ -48,8 +48,7 @@ class Arg(str, Enum):
     OPTIONAL = "optional"
 
 
-@dataclass(frozen=True, slots=True)
-class Command:
+class Command(NamedTuple):
     """One native command as the manual defines it."""
 
     mnemonic: str
@@ -286,8 +285,7 @@ _TABLE = (
 COMMANDS: dict[str, Command] = {c.mnemonic: c for c in _TABLE}
 
 
-@dataclass(frozen=True, slots=True)
-class SingleChar:
+class SingleChar(NamedTuple):
     """A single-character command (MS176E §6.3): sent without CR."""
 
     char: str

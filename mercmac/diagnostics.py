@@ -5,8 +5,8 @@ lives in `mercmac.render`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from enum import IntEnum
+from typing import NamedTuple
 
 from mercmac.source import Span
 
@@ -22,8 +22,7 @@ class Severity(IntEnum):
         return self.name.lower()
 
 
-@dataclass(frozen=True, slots=True)
-class Rule:
+class Rule(NamedTuple):
     """One check: stable code, kebab-case name, default severity and the long story."""
 
     code: str
@@ -153,8 +152,7 @@ def rule(key: str) -> Rule:
     return _BY_KEY.get(key) or _BY_KEY.get(key.upper()) or _BY_KEY[key.lower()]
 
 
-@dataclass(frozen=True, slots=True)
-class Diagnostic:
+class Diagnostic(NamedTuple):
     """One finding at one place."""
 
     rule: Rule
@@ -178,12 +176,14 @@ class Diagnostic:
         }
 
 
-@dataclass(slots=True)
 class Report:
     """Collects diagnostics for one file."""
 
-    file: str
-    items: list[Diagnostic] = field(default_factory=list)
+    __slots__ = ("file", "items")
+
+    def __init__(self, file: str, items: list[Diagnostic] | None = None):
+        self.file = file
+        self.items: list[Diagnostic] = [] if items is None else items
 
     def add(self, name: str, span: Span, message: str, severity: Severity | None = None) -> None:
         r = rule(name)

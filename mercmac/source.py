@@ -1,11 +1,10 @@
 """Source text and positions: what every diagnostic and instruction points at."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 
-@dataclass(frozen=True, slots=True)
-class Span:
+class Span(NamedTuple):
     """A 1-based line/column range in one source file."""
 
     line: int
@@ -17,8 +16,7 @@ class Span:
         return f"{self.line}:{self.column}"
 
 
-@dataclass(frozen=True, slots=True)
-class Source:
+class Source(NamedTuple):
     """A file's text, its name as given by the user, and its lines."""
 
     name: str

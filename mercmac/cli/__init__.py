@@ -5,6 +5,8 @@ that turns exceptions into a message and an exit code.
 """
 from __future__ import annotations
 
+import sys
+
 import click
 
 from mercmac import __version__
@@ -70,7 +72,7 @@ def build(file: str, output: str | None, target: str | None) -> None:
         result = compile_file(file, target=target)
         if result.report.has_errors:
             render.write_text(result.report.items, {result.source.name: result.source}, 1,
-                              click.get_text_stream("stderr"))
+                              sys.stderr)
             return EXIT_FAILED
         text = "".join(line + "\n" for line in result.program.md_lines())
         if output and output != "-":

@@ -4,7 +4,7 @@
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 from mercmac.compiler.program import Macro, Op, Program
 from mercmac.diagnostics import Report
@@ -13,8 +13,7 @@ from mercmac.source import Source, read_source
 __all__ = ["Compilation", "compile_file", "compile_source", "Macro", "Op", "Program"]
 
 
-@dataclass(frozen=True, slots=True)
-class Compilation:
+class Compilation(NamedTuple):
     """What compiling one file gives: its source, diagnostics and (if it parsed) program."""
 
     source: Source

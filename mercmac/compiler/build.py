@@ -26,7 +26,7 @@ class _Build(Transformer):
     def raw_block(self, meta, children):
         header, *rest = children
         digits = header.value.upper().strip("[] \t")[2:]  # "[ MC 05 ]" -> " 05 "
-        return ast.RawBlock(_int(digits), tuple(rest[0]) if rest else (), _span(meta))
+        return ast.RawBlock(_int(digits), tuple(rest[0]) if rest else (), _tspan(header))
 
     def raw_commands(self, meta, commands):
         return commands

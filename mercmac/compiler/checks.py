@@ -5,8 +5,6 @@ The pass also resolves what lowering needs: each valid native command as an
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 from mercmac.commands import MODELS, Arg, lookup, nearest
 from mercmac.compiler import ast
 from mercmac.compiler.program import SLOTS, Op
@@ -18,15 +16,15 @@ MAX_PERIOD_MS = 65_535  # `every T` lowers to WA T; MS176E §6.4 WA
 INPUTS = range(1, 7)  # XN/XF: 1-4 inputs, 5 joystick, 6 joystick button (§6.4 XN)
 
 
-@dataclass
 class Env:
     """What the checks resolved, for lowering."""
 
-    target: str | None = None
-    consts: dict[str, int] = field(default_factory=dict)
-    macros: dict[str, ast.MacroDef] = field(default_factory=dict)
-    ops: dict[ast.Command, Op] = field(default_factory=dict)
-    values: dict[ast.Value, int] = field(default_factory=dict)
+    def __init__(self, target: str | None = None):
+        self.target = target
+        self.consts: dict[str, int] = {}
+        self.macros: dict[str, ast.MacroDef] = {}
+        self.ops: dict[ast.Command, Op] = {}
+        self.values: dict[ast.Value, int] = {}
 
 
 def check_module(module: ast.Module, report: Report, target: str | None) -> Env:

@@ -12,7 +12,7 @@
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from mercmac.compiler import ast
 from mercmac.compiler.checks import Env
@@ -21,19 +21,19 @@ from mercmac.diagnostics import Report
 from mercmac.source import Span
 
 
-@dataclass(eq=False)
 class _Macro:
     """A macro being lowered: its EM targets may not have slots yet."""
 
-    name: str
-    origin: str
-    span: Span
-    slot: int | None = None
-    ops: list = field(default_factory=list)  # Op, or _Em before allocation
+    __slots__ = ("name", "origin", "span", "slot", "ops")
+
+    def __init__(self, name: str, origin: str, span: Span, slot: int | None = None):
+        self.name, self.origin, self.span, self.slot = name, origin, span, slot
+        self.ops: list = []  # Op, or _Em before allocation
 
 
-@dataclass(frozen=True, eq=False)
-class _Em:
+class _Em(NamedTuple):
+    """An EM whose target slot is not allocated yet."""
+
     target: _Macro
     span: Span
     role: str

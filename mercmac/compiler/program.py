@@ -5,7 +5,7 @@ show macro names, not numbers, through `Macro.name` and the spans of `Op`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from mercmac.source import Span
 
@@ -13,8 +13,7 @@ MAX_COMMANDS = 16  # MS176E §3.8: "Each macro can contain up to 16 base command
 SLOTS = range(32)  # MS176E §3.8.4: macros 0 to 31, 0 = autostart
 
 
-@dataclass(frozen=True, slots=True)
-class Op:
+class Op(NamedTuple):
     """One base command of a lowered macro.
 
     `mnemonic` is the key of `mercmac.commands.COMMANDS` (upper case, 'FA?'
@@ -34,15 +33,23 @@ class Op:
         return self.mnemonic if self.arg is None else f"{self.mnemonic}{self.arg}"
 
 
-@dataclass(slots=True)
 class Macro:
     """One slot's contents, with the name and source span it came from."""
 
-    slot: int
-    name: str
-    ops: list[Op] = field(default_factory=list)
-    span: Span | None = None
-    origin: str = "raw"  # raw, macro, autostart, when, repeat, every, rest, part, stored
+    __slots__ = ("slot", "name", "ops", "span", "origin")
+
+    def __init__(self, slot: int, name: str, ops: list[Op] | None = None,
+                 span: Span | None = None, origin: str = "raw"):
+        self.slot, self.name, self.span = slot, name, span
+        self.ops: list[Op] = [] if ops is None else ops
+        self.origin = origin  # raw, macro, autostart, when, repeat, every, rest, part, stored
+
+    def __repr__(self) -> str:
+        return f"Macro({self.slot}, {self.name!r}, {self.line!r}, origin={self.origin!r})"
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Macro) and all(
+            getattr(self, a) == getattr(other, a) for a in self.__slots__)
 
     @property
     def line(self) -> str:
@@ -61,13 +68,20 @@ class Macro:
         return tag if self.name == tag else f"{self.name} ({tag})"
 
 
-@dataclass(slots=True)
 class Program:
     """All macros of one compiled file, by slot."""
 
-    macros: dict[int, Macro]
-    target: str | None = None
-    file: str = ""
+    __slots__ = ("macros", "target", "file")
+
+    def __init__(self, macros: dict[int, Macro], target: str | None = None, file: str = ""):
+        self.macros, self.target, self.file = macros, target, file
+
+    def __repr__(self) -> str:
+        return f"Program({self.macros!r}, target={self.target!r}, file={self.file!r})"
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Program) and (self.macros, self.target, self.file) == (
+            other.macros, other.target, other.file)
 
     def ordered(self) -> list[Macro]:
         """Slot order with macro 0 last: the safe upload order (SPEC §4 rule 5)."""
