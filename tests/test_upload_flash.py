@@ -113,3 +113,18 @@ def test_reset_starts_macro_0(tmp_path):
         run_flash(server, program_of("[MC00] WA5000\n"), tmp_path, reset=True)
         assert eventually(server, lambda v: v.lines[-1] == "RT")
         assert server.call(lambda v: v.running)  # macro 0 runs after RT (MS176E §6.4 RT)
+
+
+def test_byte_goals_of_the_benchmark(capsys):
+    """Bytes, not timings: an unchanged re-flash writes nothing, a full flash <= 1.15x minimum."""
+    import importlib.util
+
+    path = EXAMPLE4.parent.parent.parent / "benchmarks" / "flash_bytes.py"
+    spec = importlib.util.spec_from_file_location("flash_bytes", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    for framing in ("etx-per-line", "one-etx"):
+        ratios = bench.main(EXAMPLE4, framing)
+        assert ratios["unchanged_writes"] == 0
+        assert ratios["full"] <= bench.GOAL_FULL
+    assert "ratio" in capsys.readouterr().out
