@@ -128,7 +128,8 @@ class Axis:
         found = (edge >= self.position(t)) == positive or edge == self.position(t)
         goal = edge if found else self._runaway(positive)
         self.move(t, round(goal))  # §6.4 FE: not affected by the soft limits
-        self.homing, self.edge_ahead = True, found
+        self.homing, self.edge_ahead = bool(self.segs), found
+        self.referenced = self.referenced or (found and not self.segs)  # already on the edge
         return found
 
     def _runaway(self, positive: bool) -> float:
