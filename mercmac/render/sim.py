@@ -147,6 +147,7 @@ def to_json(run: Run) -> str:
         "outputs": [{"t_ms": ms(o.t), "pattern": o.pattern} for o in rec.outputs],
         "hazards": [{"t_ms": ms(h.t), "rule": h.rule, "message": h.message,
                      "macro": h.where.label if h.where else None,
+                     "slot": h.where.slot if h.where else None,
                      "line": h.where.line if h.where else None} for h in rec.hazards],
     }
     if rec.dropped["reports"] or rec.dropped["outputs"]:
