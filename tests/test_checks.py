@@ -14,7 +14,6 @@ MANY = "\n".join(f"macro m{i} {{ TP }}" for i in range(33)) + "\n"
 FINDS = [
     ("syntax", "[MC01] MR5000 WS100\n", None),
     ("syntax", "[MC01] EMxx\n", None),
-    ("syntax", "[MC01] EM xx\n", None),
     ("syntax", "MR5000\n", None),
     ("syntax", "macro a {\n  TP\n", None),
     ("syntax", "macro a { goto b, TP }\nmacro b { TP }\n", None),
@@ -27,6 +26,8 @@ FINDS = [
     ("bad-argument", "[MC01] EM\n", None),
     ("bad-argument", "[MC01] TP5\n", None),
     ("bad-argument", "target C-999\n", None),
+    ("bad-argument", "[MC01] EM xx\n", None),
+    ("bad-argument", "[MC01] MR abc\n", None),
     ("argument-range", "[MC01] RP32569\n", None),
     ("argument-range", "[MC01] CN5\n", None),
     ("argument-range", "[MC01] CF0\n", None),

@@ -126,8 +126,9 @@ def _resolve(value: ast.Value, env: Env, report: Report) -> int | None:
         env.values[value] = value.value
         return value.value
     if value.name not in env.consts:
-        report.add("undefined-name", value.span,
-                   f"no const named '{value.name}'{_suggest(value.name, env.consts)}")
+        hint = (f"; '{value.name}' is a macro: write `call {value.name}` or `goto {value.name}`"
+                if value.name in env.macros else _suggest(value.name, env.consts))
+        report.add("undefined-name", value.span, f"no const named '{value.name}'{hint}")
         return None
     env.values[value] = env.consts[value.name]
     return env.consts[value.name]
@@ -145,8 +146,8 @@ def _command(cmd: ast.Command, env: Env, report: Report, *, raw: bool) -> None:
             report.add("bad-argument", cmd.value.span, f"{spec.expects()}")
             return
         if raw and isinstance(cmd.value, ast.Name):
-            report.add("syntax", cmd.value.span,
-                       f"{spec.expects()}, found '{cmd.value.name}' (names are for high-level blocks)")
+            report.add("bad-argument", cmd.value.span,
+                       f"{spec.expects()}, found '{cmd.value.name}' (a raw block takes numbers only)")
             return
         arg = _resolve(cmd.value, env, report)
         if arg is None:
