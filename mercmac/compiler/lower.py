@@ -66,7 +66,11 @@ class _Lowerer:
         return m
 
     def helper(self, owner: _Macro, kind: str, span: Span) -> _Macro:
-        return self.new(f"{owner.name}.{kind}@{span.line}", kind, span)
+        """A compiler-made macro, named after its owner and line: 'jog.when@12'."""
+        name = f"{owner.name}.{kind}@{span.line}"
+        if any(m.name == name for m in self.order):  # two blocks on one line
+            name += f":{span.column}"
+        return self.new(name, kind, span)
 
     # -- statements --------------------------------------------------------
     def seq(self, stmts: tuple, owner: _Macro, *, at_start: bool, loop: bool,
