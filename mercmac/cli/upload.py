@@ -176,7 +176,11 @@ def scan(port, baud, timeout, stop) -> None:
               help="Keep the macros (flash memory) in this file across runs.")
 @click.option("--firmware", default="2.30", show_default=True,
               help="Firmware version VE reports; 1.xx drops lines typed slower than 20 ms a character.")
-def emulate(target, address, state, firmware) -> None:
+@click.option("--tm-framing", type=click.Choice(["etx-per-line", "one-etx"]), default="etx-per-line",
+              show_default=True, help="How a TM listing ends its lines (SPEC §4 allows both).")
+@click.option("--empty-slot", type=click.Choice(["empty", "bare"]), default="empty",
+              show_default=True, help="TMn of an empty slot: an empty report or a bare MCnnn.")
+def emulate(target, address, state, firmware, tm_framing, empty_slot) -> None:
     """Serve a virtual controller on a pseudo-terminal and print the path to open.
 
     Try `mercmac flash PATH FILE` without hardware; Ctrl-C stops it.
@@ -184,11 +188,12 @@ def emulate(target, address, state, firmware) -> None:
     def work() -> int:
         from pathlib import Path
 
-        from mercmac.upload.emulator import VirtualController
+        from mercmac.upload.emulator import Faults, VirtualController
         from mercmac.upload.ptyserver import PtyServer
 
         vc = VirtualController(target.upper(), address, firmware=firmware,
-                               state=Path(state) if state else None)
+                               state=Path(state) if state else None,
+                               faults=Faults(tm_framing=tm_framing, empty_slot=empty_slot))
         try:
             server = PtyServer(vc)
         except OSError as e:

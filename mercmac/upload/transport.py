@@ -144,6 +144,15 @@ def _open(port: str, baud: int):
 
 
 def _reason(e: BaseException) -> str:
-    """pyserial's message without its errno prefix noise."""
-    text = str(getattr(e, "strerror", None) or e).strip()
+    """pyserial's message, shortened: 'No such file or directory', 'port is locked by ...'."""
+    import os
+
+    text = str(e).strip()
+    if "exclusively lock" in text:
+        return "the port is locked by another program"
+    if "returned no data" in text:  # pyserial's words for a vanished USB adapter or pty
+        return "the device disconnected"
+    errno = getattr(e, "errno", None)
+    if isinstance(errno, int) and errno > 0:
+        return os.strerror(errno)
     return text or type(e).__name__
