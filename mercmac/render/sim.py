@@ -123,7 +123,11 @@ def summary(run: Run) -> list[Line]:
 
 
 def trace(record: Recorder) -> list[Line]:
-    lines = [_at(e.t) + [(e.text, "")] for e in record.trace]
+    """Executed instructions, with the fast-forward jumps between them."""
+    skips = [e for e in record.timeline if isinstance(e, ev.FastForwarded)]
+    merged = sorted(record.trace + skips, key=lambda e: e.t)  # stable: skips after their RP
+    lines = [_at(e.t) + [(e.text, "")] if isinstance(e, ev.Executed) else event_line(e)
+             for e in merged]
     if record.dropped["trace"]:
         lines.append([(f"... {record.dropped['trace']:,} more instructions", "dim")])
     return lines

@@ -29,7 +29,7 @@ def instruction(chunk: Chunk, ip: int) -> str:
     opcode, value = chunk.code[ip]
     span = chunk.spans[ip]
     where = f"line {span.line}" if span else "no source"
-    return (f"{chunk.label:<12} #{ip:02d}  {opcode.name:<6} {operand_text(opcode, value):<10}"
+    return (f"{chunk.label:<20} #{ip:02d}  {opcode.name:<6} {operand_text(opcode, value):<10}"
             f" {chunk.texts[ip]:<12} ({where})")
 
 
