@@ -380,9 +380,10 @@ class Machine:
         t = self.clock.now
         command(t)
         self.effects += 1
+        self.mover = self._where(self.ip - 1)  # the command a limit hit will be blamed on
         self._emit(ev.MoveStarted(t, kind, self.axis.target,
                                   self.axis.arrival() if self.axis.moving(t) else t,
-                                  tuple(self.axis.segs), self._where(self.ip - 1)))
+                                  tuple(self.axis.segs), self.mover))
 
     def _halt(self, kind: str) -> None:
         self._motion(kind, self.axis.halt)
@@ -515,7 +516,7 @@ class Machine:
         if happened[0] == "limit":
             self.error = E_HARD_STOP
             self._hazard("hard-limit", f"the stage hit the {happened[1]} limit switch at "
-                         f"{round(self.axis.final)} and stopped abruptly", where=None)
+                         f"{round(self.axis.final)} and stopped abruptly", where=self.mover)
         self._emit(ev.MoveEnded(t, happened[0], round(self.axis.final)))
         if self.block and self.block[0] == "WS":
             self._unblock(t)
@@ -577,6 +578,7 @@ class Machine:
         self.limits_high = DEFAULTS[self.model].limits_high
         self.table_done = INF
         self.shown = 0
+        self.mover: ev.Where | None = None
         self.anchors.clear()
 
     def _where(self, ip: int) -> ev.Where | None:
