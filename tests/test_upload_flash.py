@@ -130,3 +130,43 @@ def test_byte_goals_of_the_benchmark(capsys):
         assert ratios["unchanged_writes"] == 0
         assert ratios["full"] <= bench.GOAL_FULL
     assert "ratio" in capsys.readouterr().out
+
+
+def test_a_socket_url_works_like_a_port(tmp_path):
+    """PORT may be any pyserial URL (SPEC §5): here socket:// to a TCP bridge of the emulator."""
+    import select
+    import socket
+    import threading
+    import time
+
+    from mercmac.upload.emulator import VirtualController
+
+    vc = VirtualController(macros={2: "TP"})
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(1)
+
+    def bridge():
+        conn, _ = listener.accept()
+        t0 = time.monotonic()
+        with conn:
+            while True:
+                ready, _, _ = select.select([conn], [], [], 0.002)
+                data = conn.recv(4096) if ready else b""
+                if ready and not data:
+                    return
+                vc.receive(data, time.monotonic() - t0)
+                if out := vc.take():
+                    conn.sendall(out)
+
+    threading.Thread(target=bridge, daemon=True).start()
+    url = f"socket://127.0.0.1:{listener.getsockname()[1]}"
+    from mercmac.upload.session import open_controller
+
+    from test_upload_emulator import FAST
+
+    with open_controller(url, 0, timing=FAST) as c:
+        who = identify(c)
+        flash(c, who, program_of("[MC02] TP\n[MC03] GH\n"), FlashOptions(backup=tmp_path / "b.mcm"))
+    listener.close()
+    assert vc.macros == {2: "TP", 3: "GH"}
