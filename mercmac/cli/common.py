@@ -7,7 +7,7 @@ from typing import Callable
 import click
 
 from mercmac.commands import MODELS
-from mercmac.errors import EXIT_INTERRUPTED, EXIT_USAGE, MercmacError
+from mercmac.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE, MercmacError
 
 MODEL_CHOICE = click.Choice(MODELS, case_sensitive=False)
 
@@ -22,11 +22,24 @@ def run_guarded(work: Callable[[], int]) -> None:
     except KeyboardInterrupt:
         _say("interrupted")
         code = EXIT_INTERRUPTED
+    except BrokenPipeError:  # `mercmac sim ... | head`: the reader has gone, so stop quietly
+        _silence_stdout()
+        code = EXIT_FAILED
     except OSError as e:
-        name = f" {e.filename}" if getattr(e, "filename", None) else ""
-        _say(f"cannot read{name}: {e.strerror or e}")
+        name = f"{e.filename}: " if getattr(e, "filename", None) else ""
+        _say(f"{name}{e.strerror or e}")
         code = EXIT_USAGE
     sys.exit(code)
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so that the interpreter's final flush cannot fail too."""
+    import os
+
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 def _say(message: str, hint: str | None = None) -> None:
