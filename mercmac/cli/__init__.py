@@ -10,7 +10,7 @@ import sys
 import click
 
 from mercmac import __version__
-from mercmac.cli.common import MODEL_CHOICE, run_guarded
+from mercmac.cli.common import MODEL_CHOICE, run_guarded, say
 from mercmac.errors import EXIT_FAILED, EXIT_OK, EXIT_USAGE, UsageError
 
 
@@ -41,7 +41,7 @@ def check(files: tuple[str, ...], target: str | None, fmt: str) -> None:
             try:
                 results.append(compile_file(f, target=target))
             except OSError as e:
-                click.echo(f"mercmac: cannot read {f}: {e.strerror or e}", err=True)
+                say(f"cannot read {f}: {e.strerror or e}")
                 unreadable += 1
         if not results:
             return EXIT_USAGE

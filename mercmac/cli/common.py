@@ -17,17 +17,17 @@ def run_guarded(work: Callable[[], int]) -> None:
     try:
         code = work()
     except MercmacError as e:
-        _say(e.message, e.hint)
+        say(e.message, e.hint)
         code = e.exit_code
     except KeyboardInterrupt:
-        _say("interrupted")
+        say("interrupted")
         code = EXIT_INTERRUPTED
     except BrokenPipeError:  # `mercmac sim ... | head`: the reader has gone, so stop quietly
         _silence_stdout()
         code = EXIT_FAILED
     except OSError as e:
         name = f"{e.filename}: " if getattr(e, "filename", None) else ""
-        _say(f"{name}{e.strerror or e}")
+        say(f"{name}{e.strerror or e}")
         code = EXIT_USAGE
     sys.exit(code)
 
@@ -42,7 +42,7 @@ def _silence_stdout() -> None:
         pass
 
 
-def _say(message: str, hint: str | None = None) -> None:
+def say(message: str, hint: str | None = None) -> None:
     click.echo(f"mercmac: {message}", err=True)
     if hint:
         click.echo(f"  hint: {hint}", err=True)

@@ -139,6 +139,11 @@ def write_text(run: Run, stream: IO[str] | None = None, *, with_trace: bool = Fa
     write_lines(body + summary(run), stream)
 
 
+def write_scenario_passed(path: str, checked: int, stream: IO[str] | None = None) -> None:
+    """The closing line of a scenario run in which every expectation held."""
+    write_lines([[(f"scenario {path}: all {checked} expectations met", "bold green")]], stream)
+
+
 def to_json(run: Run) -> str:
     """SPEC §5 `sim --format json`."""
     rec = run.record

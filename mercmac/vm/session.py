@@ -79,7 +79,9 @@ def _scenario(req: Request, program, presses, common: dict) -> bool:
         raise
     _render(req, Run(machine, record, until))
     if req.fmt == "text":
-        print(f"scenario {req.scenario}: all {checked} expectations met")
+        from mercmac.render import sim as render
+
+        render.write_scenario_passed(req.scenario, checked, sys.stdout)
     return True
 
 
