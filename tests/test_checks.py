@@ -76,6 +76,7 @@ FINDS = [
     ("model-unsupported", "[MC01] TE\n", "C-663"),
     ("model-unsupported", "target C-863\n[MC01] DP200\n", "C-663"),
     ("nested-call", "[MC01] EM2,TP\n[MC02] EM3\n[MC03] TP\n", None),
+    ("nested-call", "[MC01] EM2,EM3\n[MC02] TP,EM3\n[MC03] TP\n", None),
     ("nested-call", "macro a { call b, TP }\nmacro b { call c }\nmacro c { TP }\n", None),
     ("nested-call", "autostart { every 20ms { when 1 { call a } } }\nmacro a { TP }\n", None),
     ("undefined-macro", "[MC01] EM5,TP\n", None),

@@ -102,8 +102,8 @@ def _ends_on_purpose(program: Program, macro: Macro, then: int | None) -> bool:
         last = macro.ops[-1]
         if last.mnemonic != "EM":
             return False
-        if last.role == "goto" or (then is not None and last.arg == then):
-            return True
+        if last.role == "goto" or (last.role == "continue" and last.arg == then):
+            return True  # raw EMs never count: on raw blocks the rule is the manual's, as written
         if last.role != "continue" or last.arg not in program.macros:
             return False
         seen.add(macro.slot)
