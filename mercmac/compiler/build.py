@@ -24,12 +24,9 @@ class _Build(Transformer):
         return ast.Module(tuple(items))
 
     def raw_block(self, meta, children):
-        header, *rest = children
+        header, *commands = children
         digits = header.value.upper().strip("[] \t")[2:]  # "[ MC 05 ]" -> " 05 "
-        return ast.RawBlock(_int(digits), tuple(rest[0]) if rest else (), _tspan(header))
-
-    def raw_commands(self, meta, commands):
-        return commands
+        return ast.RawBlock(_int(digits), tuple(commands), _tspan(header))
 
     def target(self, meta, children):
         model = children[0].value.upper()
@@ -64,10 +61,10 @@ class _Build(Transformer):
         return ast.When(tuple(conditions), body, _span(meta))
 
     def condition(self, meta, children):
-        return ast.Condition(children[-1], len(children) == 2, _span(meta))
+        return ast.Condition(_value(children[-1]), len(children) == 2, _span(meta))
 
     def repeat(self, meta, children):
-        return ast.Repeat(children[0], children[1], _span(meta))
+        return ast.Repeat(_value(children[0]), children[1], _span(meta))
 
     def every(self, meta, children):
         return ast.Every(children[0], children[1], _span(meta))
@@ -82,16 +79,19 @@ class _Build(Transformer):
 
     def command(self, meta, children):
         word = children[0]
-        value = children[1] if len(children) > 1 else None
+        value = _value(children[1]) if len(children) > 1 else None
         return ast.Command(word.value, value, _span(meta), _tspan(word))
 
-    def value(self, meta, children):
-        tok = children[0]
-        if tok.type == "INT":
-            return ast.Number(_int(tok.value), _tspan(tok))
-        return ast.Name(tok.value, _tspan(tok))
+
+def _value(tok: Token) -> ast.Value:
+    if tok.type == "INT":
+        return ast.Number(_int(tok.value), _tspan(tok))
+    return ast.Name(tok.value, _tspan(tok))
+
+
+_BUILDER = _Build()
 
 
 def build(tree) -> ast.Module:
     """The AST of a parse tree."""
-    return _Build().transform(tree)
+    return _BUILDER.transform(tree)
