@@ -89,7 +89,8 @@ class _Lowerer:
                 if target is not None:
                     out.append(_Em(target, stmt.span, "call" if isinstance(stmt, ast.Call) else "goto"))
             elif isinstance(stmt, ast.Repeat) and self.count(stmt) == 1:
-                return out + self.seq(stmt.body + rest, owner, at_start=whole, loop=loop, cont=cont)
+                return out + self.seq(stmt.body + rest, owner, at_start=at_start and not out,
+                                      loop=loop, cont=cont)
             elif isinstance(stmt, ast.When) and not rest and not loop and cont is None:
                 return out + self.conditions(stmt) + self.seq(stmt.body, owner, at_start=False, loop=False)
             elif isinstance(stmt, (ast.Repeat, ast.Every)) and whole:

@@ -118,6 +118,8 @@ def _message(e, lines: list[str]) -> str:
     if 0 < line <= len(lines):
         before = lines[line - 1][: max(getattr(e, "column", 1) - 1, 0)]
     found = _found(e)
+    if found == "'.'" and before[-1:].isdigit():
+        return "arguments are whole numbers (counts, steps, ms); there is no decimal point"
     m = _MNEMONIC_BEFORE.search(before)
     command = lookup(m.group(1)) if m else None
     if command is not None and (isinstance(e, lark.UnexpectedCharacters) or found != "end of line"):
