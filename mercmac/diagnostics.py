@@ -63,12 +63,13 @@ refused or misread by the firmware. `repeat N` needs 1 <= N <= 32569 (it
 lowers to RP N-1) and `every T` 0-65535 ms (it lowers to WA T)."""),
     Rule("MM005", "too-many-commands", _E, "a macro holds more than 16 base commands", """\
 A stored macro holds at most 16 base commands (MS176E §3.8, §3.8.4). The
-controller would cut or refuse a longer line. mercmac splits a long high-level
-block into chained macros reached by a tail EM when that keeps the meaning;
-it cannot when the block repeats itself (RP repeats from the start of the
-macro, so the chain would repeat only its last part), and a raw `[MCnn]` block
-is kept exactly as written. Move part of the work into a macro of its own and
-call it, or shorten the block."""),
+controller would cut or refuse a longer line. mercmac fits a long high-level
+block when that keeps the meaning: a straight line is chained into parts
+reached by a tail EM; a loop (RP repeats the whole line, so a chain would
+repeat only its last part) keeps its line and moves runs of plain commands
+into macros it calls. Calls, XN/XF conditions and TI cannot move, and a raw
+`[MCnn]` block is kept exactly as written. Move part of the work into a macro
+of its own and call it, or shorten the block."""),
     Rule("MM006", "slot-range", _E, "macro number outside 0-31, or more than 32 macros", """\
 Macros are numbered 0 to 31 (MS176E §3.8.4); macro 0 is the autostart macro.
 A raw block or a pin (`macro NAME @n`) outside 0-31 cannot be stored, and a

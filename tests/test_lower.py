@@ -73,3 +73,23 @@ def test_names_and_spans_survive_lowering():
     hoisted = next(m for m in program.macros.values() if m.origin == "when")
     assert hoisted.name == "jog.when@3" and hoisted.span.line == 3
     assert hoisted.ops[1].span.line == 3 and hoisted.ops[1].text == "MR5"
+
+
+def test_long_loop_moves_plain_runs_into_called_macros_and_keeps_the_meaning():
+    from mercmac.compiler.build import build
+    from mercmac.compiler.checks import check_module
+    from mercmac.compiler.parse import parse
+    from mercmac.diagnostics import Report
+    from semantics import firmware_trace, high_level_trace
+
+    text = ("autostart { repeat 3 { " + ", ".join(f"MR {i}" for i in range(1, 25))
+            + ", when 1 { TP }, CN 2 } }\n")
+    program = compile_text(text).program
+    assert all(len(m.ops) <= 16 for m in program.macros.values())
+    assert program.macros[0].ops[-1].text == "RP2"
+    report = Report("t")
+    module = build(parse(text, report))
+    env = check_module(module, report, None)
+    stored = {s: [(op.mnemonic, op.arg) for op in m.ops] for s, m in program.macros.items()}
+    for inputs in (set(), {1}):
+        assert firmware_trace(stored, inputs) == high_level_trace(module, env, inputs)

@@ -68,17 +68,17 @@ def _call(program: Program, caller: Macro, index: int, op: Op, report: Report) -
     remainder = caller.ops[index + 1:]
     if not remainder or _returns(program, callee, remainder):
         return
-    inner = next(o for o in callee.ops if o.mnemonic == "EM" and o.arg in program.macros)
-    inner_name = program.macros[inner.arg].label
+    inner = program.macros[next(o.arg for o in callee.ops
+                                if o.mnemonic == "EM" and o.arg in program.macros)]
     rest = ",".join(o.text for o in remainder)
     message = (f"{caller.label} calls {callee.label} and continues ({rest}), but "
-               f"{callee.label} calls {inner_name}: the controller keeps one return point "
+               f"{callee.label} calls {inner.label}: the controller keeps one return point "
                f"(MS176E §3.8.4), so the rest of {caller.label} never runs after that")
     if op.role == "raw":
         report.add("nested-call", op.span or caller.span, message, Severity.WARNING)
     else:
         report.add("nested-call", op.span or caller.span,
-                   message + _advice(op, callee), Severity.ERROR)
+                   message + _advice(op, callee, inner), Severity.ERROR)
 
 
 def _returns(program: Program, callee: Macro, remainder: list[Op]) -> bool:
@@ -113,7 +113,10 @@ def _ends_on_purpose(program: Program, macro: Macro, then: int | None) -> bool:
     return False
 
 
-def _advice(op: Op, callee: Macro) -> str:
+def _advice(op: Op, callee: Macro, inner: Macro) -> str:
+    if inner.origin == "part":
+        return (f". {callee.label} holds more than {MAX_COMMANDS} commands, so it was chained "
+                "into parts, and a called macro must fit in one: shorten it, or `goto` it")
     if op.role == "call":
         return (". Use `goto` if the caller need not continue, or make the called macro call "
                 "nothing (a split or hoisted block calls on too)")

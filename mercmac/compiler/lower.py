@@ -160,21 +160,53 @@ class _Lowerer:
                     m.ops = self.seq(item.body, m, at_start=True, loop=False)
 
     def split(self) -> None:
-        """Chain lowered macros over 16 commands through a tail EM (MS176E §3.8)."""
+        """Fit lowered macros into 16 commands (MS176E §3.8) where the meaning allows.
+
+        A line without RP is chained through a tail EM. A loop (RP repeats the
+        whole line) keeps its line and moves runs of plain commands into macros
+        it calls: those call nothing, so the loop keeps its return point.
+        """
         for m in list(self.order):
-            part = m
-            while m.origin != "raw" and len(part.ops) > MAX_COMMANDS:
-                if any(isinstance(op, Op) and op.mnemonic == "RP" for op in part.ops):
-                    self.report.add("too-many-commands", m.span,
-                                    f"'{m.name}' needs {len(part.ops)} commands, a macro holds "
-                                    f"{MAX_COMMANDS}, and it cannot be split: its RP repeats the "
-                                    "whole line. Move part of the body into a macro and call it")
-                    break
-                tail = self.new(f"{m.name}.part{_part_number(part)}", "part", m.span)
-                keep = MAX_COMMANDS - 1
-                tail.ops, part.ops = part.ops[keep:], part.ops[:keep]
-                part.ops.append(_Em(tail, _span_of(tail.ops[0], m.span), "continue"))
-                part = tail
+            if m.origin == "raw" or len(m.ops) <= MAX_COMMANDS:
+                continue
+            if any(_is_op(op, "RP") for op in m.ops):
+                self.shrink_loop(m)
+            else:
+                self.chain(m)
+
+    def part_name(self, m: _Macro) -> str:
+        """'jog.part2', 'jog.part3', ...: the next free part name of a split macro."""
+        names = {x.name for x in self.order}
+        n = 2
+        while f"{m.name}.part{n}" in names:
+            n += 1
+        return f"{m.name}.part{n}"
+
+    def chain(self, m: _Macro) -> None:
+        part = m
+        while len(part.ops) > MAX_COMMANDS:
+            tail = self.new(self.part_name(m), "part", m.span)
+            keep = MAX_COMMANDS - 1
+            tail.ops, part.ops = part.ops[keep:], part.ops[:keep]
+            part.ops.append(_Em(tail, _span_of(tail.ops[0], m.span), "continue"))
+            part = tail
+
+    def shrink_loop(self, m: _Macro) -> None:
+        while len(m.ops) > MAX_COMMANDS:
+            runs = _movable_runs(m.ops)
+            if not runs:
+                self.report.add("too-many-commands", m.span,
+                                f"'{m.name}' needs {len(m.ops)} commands and a macro holds "
+                                f"{MAX_COMMANDS}. It cannot be split: its RP repeats the whole "
+                                "line, and what it holds cannot move into a called macro "
+                                "(calls, conditions, TI). Move part of it into a macro of its own")
+                return
+            start, end = max(runs, key=lambda r: r[1] - r[0])
+            end = min(end, start + MAX_COMMANDS)
+            part = self.new(self.part_name(m), "part", m.span)
+            part.ops = m.ops[start:end]
+            m.ops[start:end] = [_Em(part, _span_of(part.ops[0], m.span), "hoist")]
+
 
     def allocate(self) -> dict[int, _Macro]:
         taken: dict[int, _Macro] = {}
@@ -195,13 +227,31 @@ class _Lowerer:
         return taken
 
 
+def _is_op(op, mnemonic: str) -> bool:
+    return isinstance(op, Op) and op.mnemonic == mnemonic
+
+
+# Commands that behave the same in a called macro: not calls, conditions (they
+# would end the called macro, not the loop), RP, or TI (it reads the loop's counter).
+_STAY = ("EM", "XN", "XF", "RP", "TI")
+
+
+def _movable_runs(ops: list) -> list[tuple[int, int]]:
+    """[start, end) of every run of two or more commands that can move into a called macro."""
+    runs, start = [], None
+    for i, op in enumerate(ops + [None]):
+        movable = isinstance(op, Op) and op.mnemonic not in _STAY
+        if movable and start is None:
+            start = i
+        elif not movable and start is not None:
+            if i - start >= 2:
+                runs.append((start, i))
+            start = None
+    return runs
+
+
 def _tail(cont: _Macro | None, span: Span) -> list:
     return [] if cont is None else [_Em(cont, span, "continue")]
-
-
-def _part_number(m: _Macro) -> int:
-    head, _, n = m.name.rpartition(".part")
-    return int(n) + 1 if head and n.isdigit() else 2
 
 
 def _span_of(op, default: Span) -> Span:
