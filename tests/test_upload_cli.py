@@ -7,11 +7,9 @@ import subprocess
 import sys
 import time
 
-import click
 import pytest
 from click.testing import CliRunner
 
-from mercmac.cli import upload as cli_upload
 from mercmac.compiler import compile_source
 from mercmac.source import Source
 from mercmac.upload.emulator import Faults
@@ -23,22 +21,15 @@ FAST = ["--timeout", "0.3"]
 
 
 def mercmac(*args: str):
-    """Run a command in-process; through the real `main` group once it has the upload commands."""
+    """Run a command in-process through the real `main` group."""
     from mercmac.cli import main
 
-    group = main if "flash" in main.commands else click.Group(commands=cli_upload.COMMANDS)
-    return CliRunner().invoke(group, [str(a) for a in args], catch_exceptions=False)
+    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
 
 
 def command_line(*args: str) -> list[str]:
     """The same, as a separate process."""
-    from mercmac.cli import main
-
-    if "flash" in main.commands:
-        return [sys.executable, "-m", "mercmac", *args]
-    code = (f"import sys; from mercmac.cli import upload; "
-            f"upload.{args[0]}.main(sys.argv[1:], prog_name='mercmac {args[0]}')")
-    return [sys.executable, "-c", code, *args[1:]]
+    return [sys.executable, "-m", "mercmac", *args]
 
 
 @pytest.fixture

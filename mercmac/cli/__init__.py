@@ -14,7 +14,32 @@ from mercmac.cli.common import MODEL_CHOICE, run_guarded, say
 from mercmac.errors import EXIT_FAILED, EXIT_OK, EXIT_USAGE, UsageError
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class _Commands(click.Group):
+    """The group: compiler commands here, the simulator's and the uploader's imported
+    only when used (click's lazy-loading pattern), to keep `check` quick to start."""
+
+    LAZY = {
+        "sim": ("mercmac.cli.sim", "sim"),
+        "flash": ("mercmac.cli.upload", "flash"),
+        "pull": ("mercmac.cli.upload", "pull"),
+        "ports": ("mercmac.cli.upload", "ports"),
+        "scan": ("mercmac.cli.upload", "scan"),
+        "emulate": ("mercmac.cli.upload", "emulate"),
+    }
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted([*super().list_commands(ctx), *self.LAZY])
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        if name in self.LAZY:
+            import importlib
+
+            module, attribute = self.LAZY[name]
+            return getattr(importlib.import_module(module), attribute)
+        return super().get_command(ctx, name)
+
+
+@click.group(cls=_Commands, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="mercmac")
 def main() -> None:
     """Write, check, simulate and upload stand-alone macro programs for
@@ -104,15 +129,3 @@ def explain(key: str | None) -> None:
         return EXIT_OK
 
     run_guarded(work)
-
-
-def _register() -> None:
-    """Commands owned by the simulator and the uploader (thin modules: no heavy imports)."""
-    from mercmac.cli import sim, upload
-
-    main.add_command(sim.sim)
-    for command in upload.COMMANDS:
-        main.add_command(command)
-
-
-_register()

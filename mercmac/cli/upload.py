@@ -211,5 +211,3 @@ def emulate(target, address, state, firmware, tm_framing, empty_slot) -> None:
 
     run_guarded(work)
 
-
-COMMANDS = [flash, pull, ports, scan, emulate]

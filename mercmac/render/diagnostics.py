@@ -1,7 +1,6 @@
 """Diagnostics as text for people (plain or rich) and as JSON (SPEC §5)."""
 from __future__ import annotations
 
-import json
 from typing import IO, Iterable
 
 from mercmac.diagnostics import Diagnostic, Severity
@@ -55,5 +54,7 @@ def write_text(diagnostics: list[Diagnostic], sources: dict[str, Source], files:
 
 def to_json(diagnostics: Iterable[Diagnostic]) -> str:
     """The `check --format json` object (SPEC §5)."""
+    import json
+
     ordered = sorted(diagnostics, key=Diagnostic.sort_key)
     return json.dumps({"diagnostics": [d.as_json() for d in ordered]}, indent=2)
