@@ -5,8 +5,6 @@ that turns exceptions into a message and an exit code.
 """
 from __future__ import annotations
 
-import sys
-
 import click
 
 from mercmac import __version__
@@ -97,9 +95,7 @@ def build(file: str, output: str | None, target: str | None) -> None:
         from mercmac.render import diagnostics as render
 
         result = compile_file(file, target=target)
-        if result.report.has_errors:
-            render.write_text(result.report.items, {result.source.name: result.source}, 1,
-                              sys.stderr)
+        if render.write_errors(result):
             return EXIT_FAILED
         text = "".join(line + "\n" for line in result.program.md_lines())
         if output and output != "-":

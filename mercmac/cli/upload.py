@@ -83,9 +83,7 @@ def _compile(file: str, target: str | None):
     from mercmac.upload.errors import Refused
 
     result = compile_file(file, target=target)
-    if result.report.has_errors or result.program is None:
-        render.write_text(result.report.items, {result.source.name: result.source}, 1,
-                          sys.stderr)
+    if render.write_errors(result):
         against = f" for the {target}" if target else ""
         raise Refused(f"{file} has errors{against}; nothing was flashed")
     return result.program

@@ -66,7 +66,7 @@ def parse(text: str, report: Report):
             failed = True
             line = _error_line(e, len(lines))
             if line not in blanked:
-                report.add("syntax", _error_span(e, lines), _message(e, lines))
+                report.add("syntax", _error_span(e, line), _message(e, line, lines))
             if _at_end(e) or line > len(lines):
                 return None
             if line in blanked:  # the repaired line still fails: drop it
@@ -86,8 +86,7 @@ def _error_line(e, count: int) -> int:
     return line if isinstance(line, int) and line > 0 else count
 
 
-def _error_span(e, lines: list[str]) -> Span:
-    line = _error_line(e, len(lines))
+def _error_span(e, line: int) -> Span:
     column = getattr(e, "column", 1)
     column = column if isinstance(column, int) and column > 0 else 1
     token = getattr(e, "token", None)
@@ -109,12 +108,11 @@ def _repair(lines: list[str], index: int) -> str:
     return "}" * (closes - opens)
 
 
-def _message(e, lines: list[str]) -> str:
+def _message(e, line: int, lines: list[str]) -> str:
     label = _label(e)
     if label:
         return label
     before = ""
-    line = _error_line(e, len(lines))
     if 0 < line <= len(lines):
         before = lines[line - 1][: max(getattr(e, "column", 1) - 1, 0)]
     found = _found(e)

@@ -52,6 +52,19 @@ def write_text(diagnostics: list[Diagnostic], sources: dict[str, Source], files:
     write_lines(lines, stream)
 
 
+def write_errors(result, stream: IO[str] | None = None) -> bool:
+    """Show a compilation's diagnostics on stderr if it has errors; True when it had.
+
+    `build`, `sim` and `flash` refuse a file with errors this way.
+    """
+    if not result.report.has_errors and result.program is not None:
+        return False
+    import sys
+
+    write_text(result.report.items, {result.source.name: result.source}, 1, stream or sys.stderr)
+    return True
+
+
 def to_json(diagnostics: Iterable[Diagnostic]) -> str:
     """The `check --format json` object (SPEC §5)."""
     import json

@@ -76,10 +76,6 @@ class Plan:
     after: dict[int, str] = field(default_factory=dict)
 
     @property
-    def writes(self) -> list[Step]:
-        return [s for s in self.steps if s.action is Action.WRITE]
-
-    @property
     def changes_nothing(self) -> bool:
         return not self.steps
 

@@ -32,7 +32,3 @@ def instruction(chunk: Chunk, ip: int) -> str:
     return (f"{chunk.label:<20} #{ip:02d}  {opcode.name:<6} {operand_text(opcode, value):<10}"
             f" {chunk.texts[ip]:<12} ({where})")
 
-
-def disassemble(chunk: Chunk) -> list[str]:
-    """Every instruction of a chunk, one per line."""
-    return [instruction(chunk, ip) for ip in range(len(chunk.code))]

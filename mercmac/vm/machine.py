@@ -23,7 +23,7 @@ from mercmac.vm.hazards import HazardLog
 from mercmac.vm.io import Inputs, Outputs
 from mercmac.vm.models import DEFAULTS, Options, model_name
 from mercmac.vm.motion import Axis
-from mercmac.vm.opcodes import WAITS, Opcode
+from mercmac.vm.opcodes import Opcode
 from mercmac.vm.trigger import PULSE_US, Trigger
 
 INF = math.inf

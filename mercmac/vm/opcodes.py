@@ -92,8 +92,6 @@ OPERANDS: dict[Opcode, Operand] = {
     Opcode.JF, Opcode.BN, Opcode.BF, Opcode.LN, Opcode.LF, Opcode.LH, Opcode.LL,
     Opcode.RT, Opcode.RZ, Opcode.RMALL)}
 
-WAITS = frozenset({Opcode.WA, Opcode.WS, Opcode.WN, Opcode.WF})
-
 # Kinds whose commands have no behaviour of their own fall into the shared opcodes.
 _SHARED = {Kind.SETTING: Opcode.SET, Kind.REPORT: Opcode.REPORT, Kind.OUTPUT: Opcode.SET,
            Kind.MOTION: Opcode.SET}

@@ -100,9 +100,7 @@ def _compile(req: Request):
     from mercmac.render import diagnostics
 
     compiled = compile_file(req.file, target=req.target)
-    if compiled.report.has_errors or compiled.program is None:
-        diagnostics.write_text(compiled.report.items, {compiled.source.name: compiled.source}, 1,
-                               sys.stderr)
+    if diagnostics.write_errors(compiled):
         return None
     return compiled.program
 
