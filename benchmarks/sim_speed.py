@@ -7,6 +7,15 @@
 (b) `[MC00] CN1,WA20,RP,RP` run to its real end (2^32 passes, about 1094 days).
 Each case runs in a fresh interpreter, so the wall time includes start-up
 (imports, compiling the file). Goal: at most 2 s of wall time each.
+
+Loops whose passes are identical except for what they emit (issue 7, item 7),
+one simulated day each (goal: a second or two), and 100,000 presses at one
+instant (goal: well under a second, measured in-process):
+(c) a `goto` ping-pong without any wait (a busy loop);
+(d) `every 500ms { CN 1, WA 500, CF 1 }`: two LED changes a pass;
+(e) `every 20ms { TT }`: one report a pass, 4 million a day.
+`--short` runs (c)-(e) for less simulated time (for the slow code before the
+fix) and prints the wall time scaled to a simulated day.
 """
 from __future__ import annotations
 
@@ -18,6 +27,8 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 EXAMPLE4 = os.path.join(HERE, "..", "examples", "macros", "manual-example4-four-modes.mcm")
 HOUR_MS = 3_600_000
+DAY_MS = 24 * HOUR_MS
+PRESSES = 100_000
 
 
 def example4_buttons() -> str:
@@ -35,6 +46,14 @@ CASES = {
         ["-", "--until", "1500d"], None),
 }
 LOOP = "[MC00] CN1,WA20,RP,RP\n"
+# (source, simulated ms, simulated ms with --short)
+DAY_CASES = {
+    "goto ping-pong, no wait (busy loop)": (
+        "macro a { goto b }\nmacro b { goto a }\nautostart { goto a }\n", DAY_MS, 120_000),
+    "every 500ms { CN 1, WA 500, CF 1 }": (
+        "autostart {\n  every 500ms { CN 1, WA 500, CF 1 }\n}\n", DAY_MS, 2 * HOUR_MS),
+    "every 20ms { TT }": ("autostart {\n  every 20ms { TT }\n}\n", DAY_MS, 600_000),
+}
 
 
 def measure(args: list[str]) -> tuple[float, dict]:
@@ -48,7 +67,44 @@ def measure(args: list[str]) -> tuple[float, dict]:
     return time.perf_counter() - start, json.loads(done.stdout)
 
 
+def measure_source(source: str, until_ms: int) -> tuple[float, dict]:
+    """Simulate a high-level source for until_ms in a fresh interpreter; wall s and JSON."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "case.mcm")
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(source)
+        return measure([path, "--until", f"{until_ms}ms"])
+
+
+def presses_at_one_instant(count: int) -> float:
+    """Wall seconds to simulate `count` presses of buttons 1-4 at 1 s, released 1 or 2 ms later."""
+    from mercmac.compiler import compile_source
+    from mercmac.source import Source
+    from mercmac.timespec import Press
+    from mercmac.vm.simulate import simulate
+
+    program = compile_source(Source("presses.mcm", "autostart {\n  every 20ms { TC 1 }\n}\n")).program
+    presses = [Press((1, 2, 3, 4), 1000, 1001 + i % 2) for i in range(count)]
+    start = time.perf_counter()
+    simulate(program, presses=presses, until_ms=3000)
+    return time.perf_counter() - start
+
+
 def main() -> None:
+    short = "--short" in sys.argv[1:]
+    for name, (source, day_ms, short_ms) in DAY_CASES.items():
+        simulated = short_ms if short else day_ms
+        wall, result = measure_source(source, simulated)
+        emitted = len(result["reports"]) + len(result["outputs"]) + sum(
+            result.get("truncated", {}).values())
+        print(f"{name}: simulated {simulated / 1000:,.0f} s in {wall:.2f} s wall "
+              f"-> {wall * DAY_MS / simulated:,.1f} s per simulated day, ratio "
+              f"{simulated / 1000 / wall:,.0f} : 1 ({emitted:,} reports and LED changes)")
+    count = PRESSES // 5 if short else PRESSES
+    wall = presses_at_one_instant(count)
+    print(f"{count:,} presses at one instant: {wall:.2f} s wall")
     for name, (args, simulated_ms) in CASES.items():
         wall, result = measure(args)
         simulated = simulated_ms if simulated_ms is not None else result["ended_ms"]

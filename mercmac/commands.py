@@ -319,6 +319,8 @@ def nearest(word: str) -> str | None:
     word = word.upper()
     best, best_cost = None, 3
     for name in COMMANDS:
+        if abs(len(word) - len(name)) >= best_cost:  # the distance is at least that
+            continue
         cost = _distance(word, name)
         if cost < best_cost or (cost == best_cost and best and name < best):
             best, best_cost = name, cost

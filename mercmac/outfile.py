@@ -52,7 +52,7 @@ def writable_target(path: str | os.PathLike, *, make_parents: bool = False) -> P
     except FileNotFoundError:
         st = None
     except OSError as e:
-        raise OutputError(f"cannot write {given}: {e.strerror or e}") from None
+        raise OutputError(f"cannot write {given}: {reason(e)}") from None
     if st is not None and not stat.S_ISREG(st.st_mode):
         kind = next((name for test, name in _KINDS if test(st.st_mode)), "not a regular file")
         raise OutputError(f"cannot write {given}: it is {kind}, not a regular file",
@@ -62,9 +62,10 @@ def writable_target(path: str | os.PathLike, *, make_parents: bool = False) -> P
         try:
             folder.mkdir(parents=True, exist_ok=True)
         except OSError as e:
-            raise OutputError(f"cannot create the folder {folder}: {e.strerror or e}") from None
+            raise OutputError(f"cannot create the folder {folder}: {reason(e)}") from None
     if not folder.is_dir():
-        raise OutputError(f"cannot write {given}: the folder {folder} does not exist")
+        missing = "is not a folder" if folder.exists() else "does not exist"
+        raise OutputError(f"cannot write {given}: {folder} {missing}")
     if not os.access(folder, os.W_OK | os.X_OK):
         raise OutputError(f"cannot write {given}: no permission to write in {folder}")
     return target
@@ -78,10 +79,15 @@ def replacing(path: str | os.PathLike, *, binary: bool = False, encoding: str = 
     try:
         fd, tmp = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=TEMP_SUFFIX, dir=target.parent)
     except OSError as e:
-        raise OutputError(f"cannot write {path}: {e.strerror or e}") from None
+        raise OutputError(f"cannot write {path}: {reason(e)}") from None
     try:
         mode = "wb" if binary else "w"
-        with os.fdopen(fd, mode, **({} if binary else {"encoding": encoding, "newline": "\n"})) as f:
+        try:
+            f = os.fdopen(fd, mode, **({} if binary else {"encoding": encoding, "newline": "\n"}))
+        except BaseException:
+            os.close(fd)
+            raise
+        with f:
             yield f
             f.flush()
             if durable:
@@ -90,10 +96,12 @@ def replacing(path: str | os.PathLike, *, binary: bool = False, encoding: str = 
         os.replace(tmp, target)
     except OSError as e:
         _remove(tmp)
-        raise OutputError(f"cannot write {path}: {_reason(e)}") from None
+        raise OutputError(f"cannot write {path}: {reason(e)}") from None
     except BaseException:
         _remove(tmp)
         raise
+    if durable:
+        _sync_folder(target.parent)
 
 
 def write_text(path: str | os.PathLike, text: str, *, encoding: str = "utf-8",
@@ -118,9 +126,25 @@ def _copy_mode(target: Path, tmp: str) -> None:
 
 
 def _umask() -> int:
+    """The process umask, read without setting it where Linux allows (os.umask is racy in threads)."""
+    with contextlib.suppress(OSError, ValueError):
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
     mask = os.umask(0o022)
     os.umask(mask)
     return mask
+
+
+def _sync_folder(folder: Path) -> None:
+    """Make the rename itself survive a power cut (POSIX); the file is already in place, so
+    a folder that cannot be synced (Windows, some network file systems) is no error."""
+    with contextlib.suppress(OSError, AttributeError):
+        fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
 
 
 def _remove(tmp: str) -> None:
@@ -128,6 +152,16 @@ def _remove(tmp: str) -> None:
         os.unlink(tmp)
 
 
-def _reason(e: OSError) -> str:
-    """'No space left on device', never the raw tuple `(28, 'No space...')`."""
-    return e.strerror or (str(e.args[-1]) if e.args else type(e).__name__)
+def reason(e: BaseException) -> str:
+    """The cause in words: 'Input/output error', never `(5, 'Input/output error')` or `[Errno 5]`.
+
+    Also for errors that are not OSErrors but carry (errno, text) the same way (termios.error).
+    """
+    if isinstance(e, OSError) and e.strerror:
+        return e.strerror
+    args = e.args[0] if len(e.args) == 1 and isinstance(e.args[0], tuple) else e.args
+    if len(args) >= 2 and isinstance(args[0], int) and isinstance(args[1], str):
+        return args[1]
+    if len(args) == 1 and isinstance(args[0], int):
+        return os.strerror(args[0])
+    return str(e) or type(e).__name__

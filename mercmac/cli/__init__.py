@@ -49,35 +49,66 @@ def main() -> None:
 @click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output for people or for programs.")
-def check(files: tuple[str, ...], target: str | None, fmt: str) -> None:
+@click.option("--max-diagnostics", "limit", type=click.IntRange(min=0), metavar="N",
+              help="Show at most N diagnostics per file, errors first; 0 shows all. Default: "
+                   "200 in text (a closing line counts the rest), 10000 in JSON (which then "
+                   'adds "truncated": {FILE: count left out}). The summary counts them all.')
+def check(files: tuple[str, ...], target: str | None, fmt: str, limit: int | None) -> None:
     """Check .mcm files against the firmware's rules.
 
     Exit 0 when no errors are found, 1 when there are errors, 2 when a file
     cannot be read.
     """
     def work() -> int:
-        from mercmac.compiler import compile_file
         from mercmac.render import diagnostics as render
+        from mercmac.source import read_source
 
         results, unreadable = [], 0
         for f in files:
             try:
-                results.append(compile_file(f, target=target))
+                source = read_source(f)
             except OSError as e:
                 say(f"cannot read {f}: {e.strerror or e}")
                 unreadable += 1
+                continue
+            results.append(_check_one(source, target))
         if not results:
             return EXIT_USAGE
         found = [d for r in results for d in r.report.items]
         if fmt == "json":
-            click.echo(render.to_json(found))
+            click.echo(render.to_json(found, render.MAX_JSON if limit is None else limit))
         else:
-            render.write_text(found, {r.source.name: r.source for r in results}, len(results))
+            render.write_text(found, {r.source.name: r.source for r in results}, len(results),
+                              limit=render.MAX_TEXT if limit is None else limit)
         if unreadable:
             return EXIT_USAGE
         return EXIT_FAILED if any(r.report.has_errors for r in results) else EXIT_OK
 
     run_guarded(work)
+
+
+def _check_one(source, target: str | None):
+    """Compile one file; a compiler bug becomes an error on that file, and the others go on."""
+    from mercmac.compiler import Compilation, compile_source
+    from mercmac.diagnostics import Report
+    from mercmac.source import Span
+
+    from mercmac.compiler.parse import paused_gc
+
+    try:
+        with paused_gc():
+            return compile_source(source, target=target)
+    except Exception as e:  # last resort (issue 7): never a traceback, never lose the other files
+        report = Report(source.name)
+        try:
+            detail = f"{type(e).__name__}: {e}"
+        except Exception:  # an exception whose text cannot be made
+            detail = type(e).__name__
+        detail = detail if len(detail) <= 200 else detail[:200] + "..."
+        report.add("syntax", Span(1, 1, 1, 2),
+                   f"internal error while checking this file ({detail}); it was not fully "
+                   "checked - please report this with the file")
+        return Compilation(source, report, None)
 
 
 @main.command()
@@ -99,11 +130,9 @@ def build(file: str, output: str | None, target: str | None) -> None:
             return EXIT_FAILED
         text = "".join(line + "\n" for line in result.program.md_lines())
         if output and output != "-":
-            try:
-                with open(output, "w", encoding="ascii", newline="\n") as f:
-                    f.write(text)
-            except OSError as e:
-                raise UsageError(f"cannot write {output}: {e.strerror or e}") from None
+            from mercmac import outfile
+
+            outfile.write_text(output, text, encoding="ascii")  # whole or not at all; OutputError: 2
         else:
             click.echo(text, nl=False)
         return EXIT_OK

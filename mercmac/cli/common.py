@@ -1,7 +1,10 @@
 """What every command shares: option types and the one exception-to-exit-code place."""
 from __future__ import annotations
 
+import math
+import signal
 import sys
+import threading
 from typing import Callable
 
 import click
@@ -12,24 +15,109 @@ from mercmac.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE, MercmacErr
 MODEL_CHOICE = click.Choice(MODELS, case_sensitive=False)
 
 
+class FiniteFloat(click.ParamType):
+    """A float option that refuses nan and inf (float() takes them), optionally within bounds."""
+
+    name = "number"
+
+    def __init__(self, min: float | None = None, max: float | None = None, *,
+                 min_open: bool = False):
+        self.min, self.max, self.min_open = min, max, min_open
+
+    def convert(self, value, param, ctx) -> float:
+        shown = repr(value) if len(repr(value)) <= 40 else f"{repr(value)[:30]}...'"
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            self.fail(f"{shown} is not a number", param, ctx)
+        if math.isnan(number) or math.isinf(number):  # float() takes 'nan', 'inf', '1e999'
+            self.fail(f"{shown} is not a finite number", param, ctx)
+        low_ok = self.min is None or (number > self.min if self.min_open else number >= self.min)
+        if not low_ok or (self.max is not None and number > self.max):
+            self.fail(f"{shown} is out of range: use a number {self._range()}", param, ctx)
+        return number
+
+    def _range(self) -> str:
+        low = high = None
+        if self.min is not None:
+            low = f"{'above' if self.min_open else 'at least'} {self.min:g}"
+        if self.max is not None:
+            high = f"at most {self.max:g}"
+        return " and ".join(filter(None, (low, high)))
+
+
 def run_guarded(work: Callable[[], int]) -> None:
     """Run a command body; exit with its code, or with a message and no traceback."""
+    previous = _interrupt_handler()
+    failure: BaseException | None = None
     try:
-        code = work()
-    except MercmacError as e:
-        say(e.message, e.hint)
-        code = e.exit_code
-    except KeyboardInterrupt:
-        say("interrupted")
-        code = EXIT_INTERRUPTED
-    except BrokenPipeError:  # `mercmac sim ... | head`: the reader has gone, so stop quietly
-        _silence_stdout()
-        code = EXIT_FAILED
-    except OSError as e:
-        name = f"{e.filename}: " if getattr(e, "filename", None) else ""
-        say(f"{name}{e.strerror or e}")
-        code = EXIT_USAGE
+        try:
+            code = work()
+        finally:
+            # The outcome is decided: a further Ctrl-C must not cut its report short, nor
+            # land in the interpreter's shutdown ("Exception ignored in threading._shutdown").
+            _hold_interrupts()
+    except (MercmacError, KeyboardInterrupt, OSError) as e:
+        failure = e  # a Ctrl-C that came while holding still has the report in its context
+    try:
+        _hold_interrupts()
+        if failure is not None:
+            code = _tell(failure)
+    finally:
+        if not _owns_process():  # a test runner or a host program keeps its Ctrl-C
+            _release_interrupts(previous)
     sys.exit(code)
+
+
+def _tell(e: BaseException) -> int:
+    """Say why the command stopped; its exit code."""
+    if isinstance(e, KeyboardInterrupt):
+        e = _report_cut_short(e) or e
+    if isinstance(e, MercmacError):
+        say(e.message, e.hint)
+        return e.exit_code
+    if isinstance(e, KeyboardInterrupt):
+        say("interrupted")
+        return EXIT_INTERRUPTED
+    if isinstance(e, BrokenPipeError):  # `mercmac sim ... | head`: the reader has gone, so stop quietly
+        _silence_stdout()
+        return EXIT_FAILED
+    name = f"{e.filename}: " if getattr(e, "filename", None) else ""
+    say(f"{name}{getattr(e, 'strerror', None) or e}")
+    return EXIT_USAGE
+
+
+def _report_cut_short(interrupt: KeyboardInterrupt) -> MercmacError | None:
+    """The report on its way when this Ctrl-C came (a second one, during the tidy-up)."""
+    seen = interrupt.__context__
+    while seen is not None and not isinstance(seen, MercmacError):
+        seen = seen.__context__
+    return seen
+
+
+def _interrupt_handler():
+    """What Ctrl-C does now; None off the main thread, where it is not ours to change."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.getsignal(signal.SIGINT)
+
+
+def _hold_interrupts() -> None:
+    """Ignore Ctrl-C from now on (main thread only)."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _release_interrupts(previous) -> None:
+    if previous is not None:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _owns_process() -> bool:
+    """Whether mercmac's command line is the program running, not a test calling it."""
+    ctx = click.get_current_context(silent=True)
+    program = getattr(sys.modules.get("__main__"), "main", None)
+    return ctx is not None and program is ctx.find_root().command
 
 
 def _silence_stdout() -> None:

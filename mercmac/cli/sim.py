@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import click
 
-from mercmac.cli.common import MODEL_CHOICE, run_guarded
+from mercmac.cli.common import MODEL_CHOICE, FiniteFloat, run_guarded
+from mercmac.commands import MAX_INT32
 from mercmac.errors import EXIT_FAILED, EXIT_OK
 
 
@@ -22,21 +23,24 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
 @click.option("--trace", is_flag=True, help="Show every executed instruction, disassembled.")
 @click.option("--vcd", type=click.Path(dir_okay=False), metavar="OUT",
               help="Write a Value Change Dump (GTKWave, Surfer) to OUT.")
+@click.option("--vcd-limit", type=click.FloatRange(min=0), default=100, show_default=True,
+              metavar="MB", help="Stop the VCD before it passes this size (0: no limit).")
 @click.option("--interactive", is_flag=True, help="A live pushbutton box: keys 1-4, q quits.")
-@click.option("--speed", type=float, default=1.0, show_default=True,
+@click.option("--speed", type=FiniteFloat(), default=1.0, show_default=True,
               help="Simulated seconds per wall-clock second in --interactive.")
 @click.option("--scenario", type=click.Path(dir_okay=False), metavar="FILE.toml",
               help="Timed button steps and expectations; exit 1 on the first that fails.")
 @click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
-@click.option("--cycle", type=float, default=1.0, show_default=True, metavar="MS",
+@click.option("--cycle", type=FiniteFloat(), default=1.0, show_default=True, metavar="MS",
               help="Time one executed command takes.")
 @click.option("--servo-off", is_flag=True,
               help="Start with the servo off (a real controller needs MN; the manual's examples never send it).")
-@click.option("--reference-at", type=int, default=0, show_default=True, metavar="POS",
+@click.option("--reference-at", type=click.IntRange(-MAX_INT32, MAX_INT32), default=0,
+              show_default=True, metavar="POS",
               help="Position of the reference switch that FE searches for.")
 @click.option("--hard-limits", default=None, metavar="NEG,POS",
               help="Positions of the limit switches, e.g. -200000,200000 (default: none).")
-def sim(file, buttons, until, fmt, trace, vcd, interactive, speed, scenario, target, cycle,
+def sim(file, buttons, until, fmt, trace, vcd, vcd_limit, interactive, speed, scenario, target, cycle,
         servo_off, reference_at, hard_limits) -> None:
     """Simulate FILE on a virtual controller with a scripted pushbutton box.
 
@@ -48,6 +52,7 @@ def sim(file, buttons, until, fmt, trace, vcd, interactive, speed, scenario, tar
 
         request = session.Request(
             file=file, buttons=buttons, until=until, fmt=fmt, trace=trace, vcd=vcd,
+            vcd_limit_mb=vcd_limit,
             interactive=interactive, speed=speed, scenario=scenario, target=target,
             cycle_ms=cycle, servo_off=servo_off, reference_at=reference_at,
             hard_limits=hard_limits)

@@ -9,14 +9,14 @@ import sys
 
 import click
 
-from mercmac.cli.common import MODEL_CHOICE, run_guarded
+from mercmac.cli.common import MODEL_CHOICE, FiniteFloat, run_guarded
 from mercmac.errors import EXIT_FAILED, EXIT_OK, UsageError
 
 _ADDRESS = click.option("--address", type=click.IntRange(0, 15), default=0, show_default=True,
                         help="Controller address, DIP switches 1-4 (MS176E §3.1.3).")
 _BAUD = click.option("--baud", type=click.IntRange(300, 921_600), default=9600, show_default=True,
                      help="Baud rate, DIP switches 5-6.")
-_TIMEOUT = click.option("--timeout", type=click.FloatRange(0.05, 60), default=1.0,
+_TIMEOUT = click.option("--timeout", type=FiniteFloat(0.05, 60), default=1.0,
                         show_default=True, help="Seconds to wait for each reply.")
 
 
@@ -56,6 +56,8 @@ def flash(port, file, address, baud, dry_run, backup, erase_unused, reset, force
         from mercmac.upload.errors import FlashInterrupted
 
         program = _compile(file, target)
+        if backup:
+            _check_output(Path(backup))  # a device, FIFO or folder: refused before the port opens
         options = flasher.FlashOptions(erase_unused, dry_run, reset, Path(backup) if backup else None)
         with session.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
             try:
@@ -67,13 +69,28 @@ def flash(port, file, address, baud, dry_run, backup, erase_unused, reset, force
             except KeyboardInterrupt:
                 raise FlashInterrupted("interrupted before the first write; nothing was written") from None
             with view.FlashProgress() as progress:
-                result = flasher.flash(c, who, program, options, progress)
+                result = finished[0] = flasher.flash(c, who, program, options, progress)
         if dry_run:
             write_lines(view.dry_run_lines(result, address, baud))
         write_lines(view.flash_summary(result, port))
         return EXIT_OK
 
-    run_guarded(work)
+    finished = [None]  # the flash once it is complete: a Ctrl-C after that still says so
+    run_guarded(lambda: _reporting_completion(work, finished))
+
+
+def _reporting_completion(work, finished) -> int:
+    """Run `work`; a Ctrl-C once the flash is complete (closing, printing) says what was done."""
+    try:
+        return work()
+    except KeyboardInterrupt:
+        if finished[0] is None:
+            raise
+        from mercmac.render.upload import completed_text
+        from mercmac.upload.errors import FlashInterrupted
+
+        raise FlashInterrupted(f"interrupted while showing the result; {completed_text(finished[0])}") \
+            from None
 
 
 def _compile(file: str, target: str | None):
@@ -103,16 +120,18 @@ def pull(port, output, address, baud, timeout) -> None:
     these macros. Reading stops a running macro (MS176E §3.8.3).
     """
     def work() -> int:
+        from pathlib import Path
+
         from mercmac.render import upload as view
         from mercmac.render.console import write_lines
         from mercmac.upload import backup, session, survey
 
-        with session.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
-            pulled = survey.pull(c)
         to_file = output and output != "-"
         if to_file:
-            from pathlib import Path
-
+            _check_output(Path(output))  # refused before reading, which stops a running macro
+        with session.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
+            pulled = survey.pull(c)
+        if to_file:
             try:
                 backup.save(pulled.text, Path(output))
             except backup.BackupError as e:
@@ -125,6 +144,16 @@ def pull(port, output, address, baud, timeout) -> None:
         return EXIT_OK
 
     run_guarded(work)
+
+
+def _check_output(path) -> None:
+    """UsageError (exit 2) unless PATH is a regular file or a new one that can be written."""
+    from mercmac.upload import backup
+
+    try:
+        backup.check(path)
+    except backup.BackupError as e:
+        raise UsageError(str(e), hint="give the path of a file to create or replace") from None
 
 
 @click.command()
@@ -144,7 +173,7 @@ def ports() -> None:
 @click.command()
 @click.argument("port")
 @_BAUD
-@click.option("--timeout", type=click.FloatRange(0.05, 60), default=0.3, show_default=True,
+@click.option("--timeout", type=FiniteFloat(0.05, 60), default=0.3, show_default=True,
               help="Seconds to wait at each address.")
 @click.option("--stop", is_flag=True, help="Also identify controllers that run a macro (stops it).")
 def scan(port, baud, timeout, stop) -> None:
@@ -161,7 +190,7 @@ def scan(port, baud, timeout, stop) -> None:
         with session.open_controller(port, 0, baud=baud, timing=_timing(timeout)) as c:
             found = survey.scan(c.transport, stop=stop)
         write_lines(view.scan_lines(found, port))
-        return EXIT_OK if found else EXIT_FAILED
+        return EXIT_OK if survey.answered(found) else EXIT_FAILED
 
     run_guarded(work)
 

@@ -20,7 +20,22 @@ class Name(NamedTuple):
     span: Span
 
 
-Value = Union[Number, Name]
+class Invalid(NamedTuple):
+    """A number that cannot be used (too many digits, not whole milliseconds): the rule
+    and message to report where it is used."""
+
+    rule: str
+    message: str
+    span: Span
+    value = None  # as a pin or a count it is no slot and no number
+
+
+# Longer numbers are outside every range of MS176E §6.4, and int() refuses more than
+# 4,300 digits; such a literal becomes an Invalid (a slot number: TOO_BIG).
+MAX_DIGITS = 18
+TOO_BIG = 10 ** MAX_DIGITS
+
+Value = Union[Number, Name, Invalid]
 
 
 class Command(NamedTuple):
@@ -96,7 +111,7 @@ class Target(NamedTuple):
 
 class Const(NamedTuple):
     name: str
-    value: int
+    value: int | Invalid
     span: Span
 
 

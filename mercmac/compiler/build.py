@@ -14,19 +14,37 @@ def _tspan(tok: Token) -> Span:
     return Span(tok.line, tok.column, tok.end_line, tok.end_column)
 
 
-def _int(text: str) -> int:
-    return int(text.replace(" ", "").replace("\t", ""))
+def _int(text: str) -> int | None:
+    """The value of an INT token; None when it has more than MAX_DIGITS digits."""
+    text = text.replace(" ", "").replace("\t", "")
+    digits = text.lstrip("+-").lstrip("0")
+    return None if len(digits) > ast.MAX_DIGITS else int(text)
+
+
+def _number(tok: Token) -> ast.Number | ast.Invalid:
+    value = _int(tok.value)
+    if value is None:
+        digits = len(tok.value.lstrip("+- \t0"))
+        return ast.Invalid("argument-range", f"a number of {digits:,} digits is out of every range "
+                           "(no argument of the controller has more than 10)", _tspan(tok))
+    return ast.Number(value, _tspan(tok))
 
 
 @v_args(meta=True)
 class _Build(Transformer):
+    def __init__(self):
+        super().__init__(visit_tokens=False)  # no token callbacks: skip a failed getattr per token
+        for name in _RULES:  # lark's v_args makes a wrapper at every access: bind each once
+            setattr(self, name, getattr(self, name))
+
     def start(self, meta, items):
         return ast.Module(tuple(items))
 
     def raw_block(self, meta, children):
         header, *commands = children
         digits = header.value.upper().strip("[] \t")[2:]  # "[ MC 05 ]" -> " 05 "
-        return ast.RawBlock(_int(digits), tuple(commands), _tspan(header))
+        slot = _int(digits)
+        return ast.RawBlock(ast.TOO_BIG if slot is None else slot, tuple(commands), _tspan(header))
 
     def target(self, meta, children):
         model = children[0].value.upper()
@@ -34,7 +52,9 @@ class _Build(Transformer):
 
     def const(self, meta, children):
         name, value = children
-        return ast.Const(name.value, _int(value.value), _span(meta))
+        number = _number(value)
+        kept = number.value if isinstance(number, ast.Number) else number
+        return ast.Const(name.value, kept, _span(meta))
 
     def macro(self, meta, children):
         name, *rest = children
@@ -42,7 +62,7 @@ class _Build(Transformer):
         return ast.MacroDef(name.value, pin, rest[-1], _span(meta))
 
     def pin(self, meta, children):
-        return ast.Number(_int(children[0].value), _tspan(children[0]))
+        return _number(children[0])
 
     def autostart(self, meta, children):
         return ast.Autostart(children[0], _span(meta))
@@ -75,7 +95,11 @@ class _Build(Transformer):
             return ast.Name(tok.value, _tspan(tok))
         from mercmac.timespec import parse_duration
 
-        return ast.Number(parse_duration(tok.value), _tspan(tok))
+        try:
+            return ast.Number(parse_duration(tok.value), _tspan(tok))
+        except (ValueError, OverflowError) as e:  # TimeSpecError is a ValueError
+            return ast.Invalid("bad-argument", f"every takes a whole number of milliseconds: {e}",
+                               _tspan(tok))
 
     def command(self, meta, children):
         word = children[0]
@@ -85,13 +109,17 @@ class _Build(Transformer):
 
 def _value(tok: Token) -> ast.Value:
     if tok.type == "INT":
-        return ast.Number(_int(tok.value), _tspan(tok))
+        return _number(tok)
     return ast.Name(tok.value, _tspan(tok))
 
 
+_RULES = [name for name in vars(_Build) if not name.startswith("_")]
 _BUILDER = _Build()
 
 
 def build(tree) -> ast.Module:
     """The AST of a parse tree."""
-    return _BUILDER.transform(tree)
+    from mercmac.compiler.parse import paused_gc
+
+    with paused_gc():
+        return _BUILDER.transform(tree)

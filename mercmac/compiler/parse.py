@@ -1,11 +1,16 @@
 """Text -> parse tree, with every syntax error reported in one run.
 
 Lark's exceptions are translated here and nowhere else. After an error the
-offending line is blanked (its braces kept, so that blocks still nest) and
-the file is parsed again, so several broken lines give several diagnostics.
+rest of the offending line is skipped and the parser carries on in one pass
+(lark's `on_error`): its stack is unwound to where a line may end, and the
+line's unbalanced braces are replayed so that blocks still nest. Checking a
+file therefore costs time in proportion to its size, however many errors it
+holds (issue 7).
 """
 from __future__ import annotations
 
+import contextlib
+import gc
 import re
 
 from mercmac.commands import lookup
@@ -13,8 +18,10 @@ from mercmac.compiler import parser_tables as lark
 from mercmac.diagnostics import Report
 from mercmac.source import Span
 
-MAX_RECOVERIES = 50
-
+# `when`/`repeat`/`every` blocks nested deeper cannot fit the controller: each level needs
+# a macro or a condition of its own and there are 32 macros of 16 commands (MS176E §3.8).
+MAX_NESTING = 32
+_NESTED = ("when", "repeat", "every")
 _PARSER = None
 
 # Terminal names of grammar.lark as a person would call them.
@@ -42,7 +49,20 @@ _EXAMPLES = {
         "macro { }\n", "macro 5 { }\n", "macro a 5 { }\n", "macro a @ { }\n",
     ],
 }
-_MNEMONIC_BEFORE = re.compile(r"([A-Za-z]{2}\??)[ \t]*$")
+_MNEMONIC_BEFORE = re.compile(r"(?<![A-Za-z])([A-Za-z]{2}\??)[ \t]*$")
+
+
+@contextlib.contextmanager
+def paused_gc():
+    """Hold the cycle collector while a large tree is built: the parse makes no cycles worth
+    collecting, and each collection rescans every node made so far (2x on a 1 MB file)."""
+    was_on = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_on:
+            gc.enable()
 
 
 def parser():
@@ -55,35 +75,135 @@ def parser():
 
 def parse(text: str, report: Report):
     """The parse tree of `text`, or None after reporting every syntax error."""
-    lines = text.split("\n")
-    blanked: set[int] = set()
-    failed = False
-    for _ in range(MAX_RECOVERIES):
+    nul = text.find("\x00")
+    if nul >= 0:
+        report.add("syntax", _span_at(text, nul),
+                   "the file holds NUL characters: it looks like a binary file, not .mcm text "
+                   "(UTF-8, Windows-1252, or UTF-16 with a byte-order mark)")
+        return None
+    recovery = _Recovery(report)
+    try:
+        with paused_gc():
+            tree = parser().parse(text + "\n", on_error=recovery)
+    except lark.UnexpectedInput:  # reported; recovery stopped at the end of the file
+        return None
+    if recovery.failed:
+        return None
+    if text.count("{") > MAX_NESTING:
+        _limit_nesting(tree, report)
+    return tree
+
+
+def _span_at(text: str, index: int) -> Span:
+    line = text.count("\n", 0, index) + 1
+    column = index - text.rfind("\n", 0, index)
+    return Span(line, column, line, column + 1)
+
+
+class _Recovery:
+    """lark's `on_error`: report the error, skip the rest of its line and carry on."""
+
+    def __init__(self, report: Report):
+        self.report = report
+        self.failed = False
+        self.last: tuple[int, int] | None = None  # (line, position) of the last error
+
+    def __call__(self, e) -> bool:
+        self.failed = True
+        lexer = e.interactive_parser.lexer_thread.state
+        text, position = lexer.text.text, lexer.line_ctr.char_pos
+        line = _error_line(e, text)
+        if (line, position) == self.last:  # no progress: give up rather than loop
+            return False
+        if self.last is None or self.last[0] != line or _at_end(e):  # one error per line
+            self.report.add("syntax", _error_span(e, line), _message(e, line, _before(e, text)))
+        self.last = (line, position)
+        if _at_end(e):
+            return False
         try:
-            tree = parser().parse("\n".join(lines) + "\n")
-            return None if failed else tree
-        except lark.UnexpectedInput as e:
-            failed = True
-            line = _error_line(e, len(lines))
-            if line not in blanked:
-                report.add("syntax", _error_span(e, line), _message(e, line, lines))
-            if _at_end(e) or line > len(lines):
-                return None
-            if line in blanked:  # the repaired line still fails: drop it
-                lines[line - 1] = ""
+            return _resume(e, lexer, text, position)
+        except lark.UnexpectedInput:  # the replayed braces do not fit: stop here
+            return False
+
+
+def _resume(e, lexer, text: str, position: int) -> bool:
+    """Skip to the end of the line, unwind the stack until a line may end, replay braces."""
+    token = getattr(e, "token", None)
+    at_newline = token is not None and token.type == "_NL"
+    end = position if at_newline else text.find("\n", position)
+    end = len(text) if end < 0 else end
+    start = token.start_pos if token is not None and not at_newline else position
+    code = text[start:end].split("//", 1)[0]  # braces in the skipped text, comments aside
+    lexer.line_ctr.feed(text[position:end])
+    state = e.interactive_parser.parser_state
+    while not _accepts(state, "_NL"):
+        if len(state.state_stack) == 1:
+            return False
+        state.state_stack.pop()
+        state.value_stack.pop()
+    counter = lexer.line_ctr
+    where = token if token is not None else lark.Token(
+        "_NL", "", position, counter.line, counter.column, counter.line, counter.column, position)
+    opens, closes = code.count("{"), code.count("}")
+    if opens > closes:  # a block was opened: open one in its place so that its '}' still fits
+        state.feed_token(lark.Token.new_borrow_pos("_NL", "\n", where))
+        top = _accepts(state, "MACRO")  # `macro _ {` at the top, `when 1 {` in a block
+        head = (("MACRO", "macro"), ("NAME", "_")) if top else (("WHEN", "when"), ("INT", "1"))
+        for kind, value in (*head, ("LBRACE", "{")):
+            state.feed_token(lark.Token.new_borrow_pos(kind, value, where))
+    for _ in range(closes - opens):
+        if not _accepts(state, "RBRACE"):
+            break
+        state.feed_token(lark.Token.new_borrow_pos("RBRACE", "}", where))
+    if at_newline:  # the lexer has consumed it
+        state.feed_token(token)
+    return True
+
+
+def _accepts(state, kind: str) -> bool:
+    """Whether the parser would shift a token of this kind, after the reductions it implies
+    (an LALR table also lists kinds that only a later state refuses)."""
+    states = state.parse_conf.states
+    stack = list(state.state_stack)
+    while True:
+        action = states[stack[-1]].get(kind)
+        if action is None:
+            return False
+        what, rule = action
+        if what is lark.Shift:
+            return True
+        if rule.expansion:
+            del stack[-len(rule.expansion):]
+        stack.append(states[stack[-1]][rule.origin.name][1])
+
+
+def _limit_nesting(tree, report: Report) -> None:
+    """Report blocks nested beyond MAX_NESTING and empty them, so that nothing downstream
+    recurses that deep. Iterative: the tree may be thousands of levels deep."""
+    stack = [(tree, 0)]
+    while stack:
+        node, depth = stack.pop()
+        for child in getattr(node, "children", ()):
+            if not hasattr(child, "data"):
+                continue
+            level = depth + (child.data in _NESTED)
+            if level > MAX_NESTING:
+                line, column = child.meta.line, child.meta.column
+                report.add("slot-range", Span(line, column, line, column + len(child.data)),
+                           f"blocks nested more than {MAX_NESTING} deep cannot fit the controller "
+                           "(32 macros of 16 commands): move inner blocks into macros of their own")
+                child.children[-1].children = []
             else:
-                blanked.add(line)
-                lines[line - 1] = _repair(lines, line - 1)
-    return None
+                stack.append((child, level))
 
 
 def _at_end(e) -> bool:
     return isinstance(e, lark.UnexpectedEOF) or getattr(getattr(e, "token", None), "type", "") == "$END"
 
 
-def _error_line(e, count: int) -> int:
+def _error_line(e, text: str) -> int:
     line = getattr(e, "line", -1)
-    return line if isinstance(line, int) and line > 0 else count
+    return line if isinstance(line, int) and line > 0 else text.count("\n")
 
 
 def _error_span(e, line: int) -> Span:
@@ -94,28 +214,24 @@ def _error_span(e, line: int) -> Span:
     return Span(line, column, line, column + max(width, 1))
 
 
-def _code(line: str) -> str:
-    return line.split("//", 1)[0]
+def _before(e, text: str, limit: int = 80) -> str:
+    """The text of the error's line before the error (at most `limit` characters)."""
+    token = getattr(e, "token", None)
+    position = token.start_pos if token is not None else getattr(e, "pos_in_stream", None)
+    if not isinstance(position, int) or position < 0:
+        return ""
+    start = max(text.rfind("\n", 0, position) + 1, position - limit)
+    return text[start:position]
 
 
-def _repair(lines: list[str], index: int) -> str:
-    """A broken line blanked, with its braces kept so that blocks still nest."""
-    code = _code(lines[index])
-    opens, closes = code.count("{"), code.count("}")
-    if opens > closes:
-        depth = sum(_code(l).count("{") - _code(l).count("}") for l in lines[:index])
-        return "macro _ {" if depth <= 0 else "when 1 {"
-    return "}" * (closes - opens)
-
-
-def _message(e, line: int, lines: list[str]) -> str:
+def _message(e, line: int, before: str) -> str:
     label = _label(e)
     if label:
         return label
-    before = ""
-    if 0 < line <= len(lines):
-        before = lines[line - 1][: max(getattr(e, "column", 1) - 1, 0)]
     found = _found(e)
+    if isinstance(e, lark.UnexpectedCharacters) and not e.char.isascii():
+        return (f"unexpected {found}: names and commands are ASCII letters, digits and '_' "
+                "(arguments are ASCII digits)")
     if found == "'.'" and before[-1:].isdigit():
         return "arguments are whole numbers (counts, steps, ms); there is no decimal point"
     m = _MNEMONIC_BEFORE.search(before)

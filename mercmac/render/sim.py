@@ -7,6 +7,7 @@ from typing import IO
 
 from mercmac.render.console import Line, write_lines
 from mercmac.vm import events as ev
+from mercmac.vm import fastforward as ff
 from mercmac.vm.record import Folded, Recorder
 from mercmac.vm.simulate import Run
 
@@ -67,13 +68,26 @@ def event_line(event) -> Line | None:
             return _at(t) + [(f"home defined: position is now {position}", "green"), (_where(where), "dim")]
         case ev.ProgramEnded(t):
             return _at(t) + [("program ended: back in direct mode", "bold")]
-        case ev.FastForwarded(t, t_to, passes, period, loop):
+        case ev.FastForwarded(t, t_to, passes, period, loop, shape):
             return _at(t) + [(f"fast-forward {passes:,} identical passes of {loop.label} "
-                              f"({period / 1000:g} ms each) to {clock(t_to)}", "magenta"),
-                             (_where(loop), "dim")]
+                              f"({_span(period)}{_emitted(shape)} each) to {clock(t_to)}",
+                              "magenta"), (_where(loop), "dim")]
         case Folded():
             return _folded(event)
     return None
+
+
+def _span(t_us: int) -> str:
+    """A pass's length: '22 ms' up to 10 s, then as a clock ('00:24:01.790')."""
+    return f"{t_us / 1000:g} ms" if t_us < 10_000_000 else clock(t_us)
+
+
+def _emitted(shape: tuple) -> str:
+    """', 1 report, 2 LED changes': what each skipped pass emitted (counted in the summary)."""
+    reports, changes = ff.count(shape, ff.REPORT), ff.count(shape, ff.OUTPUTS)
+    parts = ([f"{reports:,} report{'s' * (reports != 1)}"] if reports else []) + \
+        ([f"{changes:,} LED change{'s' * (changes != 1)}"] if changes else [])
+    return "".join(f", {part}" for part in parts)
 
 
 def _folded(fold: Folded) -> Line:
@@ -137,6 +151,13 @@ def write_text(run: Run, stream: IO[str] | None = None, *, with_trace: bool = Fa
     """The timeline (or trace) and the summary, for people."""
     body = trace(run.record) if with_trace else timeline(run.record)
     write_lines(body + summary(run), stream)
+
+
+def write_vcd_cut(path: str, limit_mb: float, cut_at: int, stream: IO[str] | None = None) -> None:
+    """The warning for a VCD that stopped at its size limit (the run itself went on)."""
+    write_lines([[(f"mercmac: warning: {path} stops at {clock(cut_at)}: it reached the "
+                   f"--vcd-limit of {limit_mb:g} MB; raise --vcd-limit (0: no limit) or "
+                   "shorten --until", "yellow")]], stream)
 
 
 def write_scenario_passed(path: str, checked: int, stream: IO[str] | None = None) -> None:

@@ -37,9 +37,11 @@ class FlashProgress:
         if use_colour(self.stream):
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
+            # no refresh thread: it would keep redrawing the bar over the message of a
+            # Ctrl-C that cut `stop` short; the bar is redrawn on each event instead
             self._progress = Progress(TextColumn("[bold]{task.description:<28}"), BarColumn(),
                                       MofNCompleteColumn(), console=rich_console(self.stream),
-                                      transient=True)
+                                      transient=True, auto_refresh=False)
             self._progress.start()
         return self
 
@@ -55,7 +57,8 @@ class FlashProgress:
         if event.kind in ("step", "verified"):
             if self._task is None:
                 self._task = self._progress.add_task(event.text, total=event.total)
-            self._progress.update(self._task, description=event.text, completed=event.done)
+            self._progress.update(self._task, description=event.text, completed=event.done,
+                                  refresh=True)
         else:
             from rich.text import Text
 
@@ -75,16 +78,10 @@ def flash_summary(result, port: str) -> list[Line]:
     rows = [(f"MC{slot:02d}", _name(plan.names.get(slot), slot), fate.value)
             for slot, fate in sorted(plan.fates.items())]
     lines = table(("slot", "macro", "result"), rows, style_of=lambda row: _FATE_STYLE.get(row[2], ""))
-    counts = {}
-    for fate in plan.fates.values():
-        counts[fate.value] = counts.get(fate.value, 0) + 1
-    tally = ", ".join(f"{n} {what}" for what, n in counts.items()) or "no macros"
     if result.dry_run:
-        lines.append([("dry run: ", "bold yellow"), (f"nothing written ({tally})", "")])
+        lines.append([("dry run: ", "bold yellow"), (f"nothing written ({_tally(plan)})", "")])
         return lines
-    done = "nothing to write: the controller already holds this program" if plan.changes_nothing \
-        else f"flashed and verified: {tally}"
-    lines.append([("ok: ", "bold green"), (done, "")])
+    lines.append([("ok: ", "bold green"), (_outcome(plan), "")])
     if result.retried or result.repaired:
         again = ", ".join(f"MC{s:02d}" for s in result.retried + result.repaired)
         lines.append([("note: ", "bold yellow"), (f"needed a second write: {again} (check the cable)", "")])
@@ -94,6 +91,28 @@ def flash_summary(result, port: str) -> list[Line]:
     elif 0 in plan.after and not plan.changes_nothing:
         lines.append([("", ""), ("macro 0 runs at the next power-on (or use --reset)", "dim")])
     return lines
+
+
+def completed_text(result) -> str:
+    """The outcome of a finished flash in plain words, for a Ctrl-C while it is being shown."""
+    if result.dry_run:
+        return f"dry run complete, nothing was written ({_tally(result.plan)})"
+    reset = "; RT was sent, macro 0 is starting" if result.reset else ""
+    return f"the flash had finished: {_outcome(result.plan)}{reset}\n  backup: {result.backup}"
+
+
+def _outcome(plan) -> str:
+    if plan.changes_nothing:
+        return "nothing to write: the controller already holds this program"
+    return f"flashed and verified: {_tally(plan)}"
+
+
+def _tally(plan) -> str:
+    """'2 written, 1 unchanged': how many slots met each fate."""
+    counts: dict[str, int] = {}
+    for fate in plan.fates.values():
+        counts[fate.value] = counts.get(fate.value, 0) + 1
+    return ", ".join(f"{n} {what}" for what, n in counts.items()) or "no macros"
 
 
 def dry_run_lines(result, address: int, baud: int) -> list[Line]:
@@ -123,7 +142,12 @@ def scan_lines(found, port: str) -> list[Line]:
         return [[("no controller answered", "bold yellow"), (f" on {port} at addresses 0-15", "")]]
     rows = [(str(f.address), f.model, f.version.firmware if f.version else "?", f.note)
             for f in found]
-    return table(("address", "model", "firmware", "note"), rows)
+    lines = table(("address", "model", "firmware", "note"), rows)
+    if not any(f.status for f in found):
+        lines.append([("no controller answered like a Mercury", "bold yellow"),
+                      (f" on {port}: garbled replies come from a baud rate other than the "
+                       f"controllers' (check --baud)", "")])
+    return lines
 
 
 def ports_lines(ports) -> list[Line]:

@@ -7,12 +7,10 @@ these macros.
 from __future__ import annotations
 
 import datetime as _dt
-import os
 import re
-import tempfile
 from pathlib import Path
 
-from mercmac import __version__
+from mercmac import __version__, outfile
 from mercmac.upload.protocol import Version
 
 
@@ -52,18 +50,25 @@ def default_path(port: str, address: int, when: _dt.datetime | None = None) -> P
     return path
 
 
-def save(text: str, path: Path) -> Path:
-    """Write atomically and durably: a power cut leaves the old file or the whole new one."""
+def check(path: Path) -> Path:
+    """The file a save to PATH will replace (its folders made), or BackupError: call it before
+    the controller is touched, so that a device, a FIFO or a folder is refused first."""
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=".mercmac-", suffix=".tmp", dir=path.parent)
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except OSError as e:
-        raise BackupError(f"cannot write {path}: {e.strerror or e}") from None
+        return outfile.writable_target(path, make_parents=True)
+    except outfile.OutputError as e:
+        raise BackupError(e.message) from None
+
+
+def save(text: str, path: Path) -> Path:
+    """Write atomically and durably: a power cut leaves the old file or the whole new one.
+
+    Only a regular file (or a new path) is replaced; a symlink is followed and the old file's
+    permissions are kept (mercmac.outfile). Returns PATH as given.
+    """
+    try:
+        outfile.write_text(path, text, make_parents=True)
+    except outfile.OutputError as e:
+        raise BackupError(e.message) from None
     return path
 
 

@@ -12,9 +12,12 @@ from typing import Callable
 
 from mercmac.upload import protocol
 from mercmac.upload.protocol import ProtocolError, Status, Version
-from mercmac.upload.transport import PortLost, ReadTimeout, Transport, TransportError
+from mercmac.upload.transport import LONGEST_REPLY, PortLost, ReadTimeout, Transport, TransportError
 
 READ_ATTEMPTS = 2  # a read is harmless to repeat; a lost character in `TM5` costs one retry
+MAX_SKIPPED = 32  # stale reports skipped per exchange: a macro's last few lines, never a flood
+LISTED = frozenset(range(1, 32))  # the slots `TM` lists (MS176E §6.4 TM): at most 31 lines
+SHORT_REPORT = 64  # bytes: a TS report is 20, so '%' needs far less than a TM listing
 
 
 class ControllerError(Exception):
@@ -33,6 +36,10 @@ class BadReply(ControllerError):
     """Something came, but not what the command reports."""
 
 
+class Flood(BadReply):
+    """Replies kept coming, none of them the answer: the exchange was cut off by count or time."""
+
+
 class LinkLost(ControllerError):
     """The port failed under us."""
 
@@ -49,12 +56,17 @@ class Controller:
 
     def status(self, timeout: float | None = None) -> Status | None:
         """TS by its single character `%`, which does not stop a running macro (§6.3); None if silent."""
-        self.transport.discard_input()
-        self._send(protocol.STATUS_CHAR)  # '%': single-character TS, no CR (§6.3)
         try:
-            return protocol.parse_status(self._await("%", protocol.is_status, timeout))
+            return self.probe(timeout)
         except (NoAnswer, BadReply):
             return None  # silence or noise here is judged by the VE that follows
+
+    def probe(self, timeout: float | None = None) -> Status:
+        """Like `status`, but NoAnswer or BadReply (quoting what came) instead of None."""
+        self._discard("%")
+        self._send(protocol.STATUS_CHAR)  # '%': single-character TS, no CR (§6.3)
+        report = self._await("%", protocol.is_status, timeout, size=SHORT_REPORT)
+        return protocol.parse_status(report)
 
     def identify(self) -> Version:
         """VE: model and firmware (§3.3). Its first character also stops a running macro (§3.8.3)."""
@@ -68,12 +80,13 @@ class Controller:
 
     def read_all(self) -> dict[int, str]:
         """Every stored macro: `TM` for 1-31 in either framing of SPEC §4, then `TZ`."""
-        first = self._ask("TM", lambda r: _lists_only(r, set(range(1, 32))))
+        first = self._ask("TM", lambda r: _lists_only(r, LISTED))
+        stop = time.monotonic() + self.transport.timing.budget(self.transport.baud)
         macros = self._macros(first, "TM")
         if len(protocol.lines(first)) == 1:
             # One line then ETX: either the only macro, or the first of an
             # ETX-per-line listing (SPEC §4). More lines follow without a pause.
-            self._listing_rest(macros)
+            self._listing_rest(macros, stop)
         zero = self.read_slot(0)
         if zero:
             macros[0] = zero
@@ -106,36 +119,50 @@ class Controller:
         """Send a report command and return the first report `accept` takes."""
         data = protocol.command(line)
         for attempt in range(READ_ATTEMPTS):
-            try:
-                self.transport.discard_input()
-            except TransportError as e:
-                raise LinkLost(str(e), sent=line) from None
+            self._discard(line)
             self._send(data)
             try:
                 return self._await(line, accept)
+            except Flood:
+                raise  # asking again only prolongs a flood
             except (NoAnswer, BadReply):
                 if attempt + 1 == READ_ATTEMPTS:
                     raise
 
-    def _await(self, line: str, accept: Callable[[str], bool], timeout: float | None = None) -> str:
-        """Reports until one fits; stale ones skipped, all bounded by the transport's budget."""
+    def _discard(self, line: str) -> None:
+        try:
+            self.transport.discard_input()
+        except TransportError as e:
+            raise LinkLost(str(e), sent=line) from None
+
+    def _await(self, line: str, accept: Callable[[str], bool], timeout: float | None = None,
+               *, size: int = LONGEST_REPLY) -> str:
+        """Reports until one fits; stale ones skipped, at most MAX_SKIPPED of them and
+        for no longer than `size` bytes take plus a timeout (a flood of junk ends too)."""
         skipped: list[str] = []
-        stop = time.monotonic() + self.transport.timing.budget(self.transport.baud)
+        stop = time.monotonic() + self.transport.timing.budget(self.transport.baud, size)
         while True:
             try:
-                report = self.transport.read_report(timeout)
+                report = self.transport.read_report(timeout, stop)
             except PortLost as e:
                 raise LinkLost(str(e), sent=line) from None
             except ReadTimeout as e:
-                raise self._silence(line, skipped, e.partial) from None
+                raise self._silence(line, skipped, e) from None
             if accept(report):
                 return report
             skipped.append(report)
-            if time.monotonic() > stop:
-                raise self._silence(line, skipped, "")
+            if len(skipped) > MAX_SKIPPED or time.monotonic() > stop:
+                raise Flood(f"unexpected answer to {line}: {len(skipped)} reports, none an "
+                            f"answer to it, the last {protocol.quote(report)}",
+                            sent=line, reply=report)
 
-    def _silence(self, line: str, skipped: list[str], partial: str) -> ControllerError:
-        timeout = self.transport.timing.timeout
+    def _silence(self, line: str, skipped: list[str], cause: ReadTimeout) -> ControllerError:
+        """What a read that ended without the answer means: silence, junk, or endless bytes."""
+        timeout, partial = self.transport.timing.timeout, cause.partial
+        if cause.endless:
+            came = partial or (skipped[-1] if skipped else "")
+            return Flood(f"unexpected answer to {line}: {cause}: {protocol.quote(came)}",
+                         sent=line, reply=came)
         if skipped or partial.strip():
             last = skipped[-1] if skipped else partial
             return BadReply(f"unexpected answer to {line}: {protocol.quote(last)}",
@@ -143,25 +170,40 @@ class Controller:
         return NoAnswer(f"no answer to {line} within {timeout:g} s", sent=line)
 
     def _macros(self, report: str, line: str) -> dict[int, str]:
+        if len(protocol.lines(report)) > len(LISTED):
+            raise BadReply(f"unexpected answer to {line}: {len(protocol.lines(report))} lines, more "
+                           f"than the {len(LISTED)} slots it lists: {protocol.quote(report)}",
+                           sent=line, reply=report)
         try:
             return protocol.parse_macros(report)
         except ProtocolError as e:
             raise BadReply(f"unexpected answer to {line}: {e} {protocol.quote(report)}",
                            sent=line, reply=report) from None
 
-    def _listing_rest(self, macros: dict[int, str]) -> None:
-        """Further one-line reports of a TM listing, until `settle` seconds of quiet."""
+    def _listing_rest(self, macros: dict[int, str], stop: float) -> None:
+        """Further one-line reports of a TM listing, until `settle` seconds of quiet;
+        at most 31 lines in all and no later than `stop` (an endless listing is refused)."""
+        count = 1
         while True:
             try:
-                report = self.transport.read_report(self.transport.timing.settle)
+                report = self.transport.read_report(self.transport.timing.settle, stop)
             except PortLost as e:
                 raise LinkLost(str(e), sent="TM") from None
             except ReadTimeout as e:
+                if e.endless:
+                    raise self._silence("TM", [], e) from None
                 if e.partial.strip():
                     raise BadReply(f"TM listing cut short: {protocol.quote(e.partial)}",
                                    sent="TM", reply=e.partial) from None
                 return
-            if _lists_only(report, set(range(1, 32))):
+            count += len(protocol.lines(report))
+            if count > len(LISTED):
+                raise Flood(f"TM listed {count} lines, more than the {len(LISTED)} slots it "
+                               f"lists; the last {protocol.quote(report)}", sent="TM", reply=report)
+            if time.monotonic() > stop:
+                raise Flood(f"TM listing still going after {count} lines; the last "
+                               f"{protocol.quote(report)}", sent="TM", reply=report)
+            if _lists_only(report, LISTED):
                 for slot, text in self._macros(report, "TM").items():
                     if macros.get(slot, text) != text:
                         raise BadReply(f"TM listed macro {slot} twice with different contents",

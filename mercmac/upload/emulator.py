@@ -7,29 +7,54 @@ else (motion, waits, reports, TS, TB, VE, running stored macros) is the
 simulator's VM, `mercmac.vm.Machine`, advanced with wall time; its reports
 module formats every report. `Faults` makes it misbehave the way real links
 do. ptyserver.py serves it on a pseudo-terminal.
+
+Nothing a host sends stops it: a line it cannot take is refused with the
+firmware's TS error code (02, 05, 06), and a `--state` file it cannot read is
+refused before it serves, never overwritten.
 """
 from __future__ import annotations
 
 import json
-import os
+import logging
 import re
-import tempfile
+from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 from mercmac.commands import C863, COMMANDS, SINGLE_CHARS, Arg
 from mercmac.compiler.program import Macro, Op, Program
+from mercmac.errors import UsageError
+from mercmac.outfile import OutputError, writable_target, write_text
 from mercmac.upload import protocol
 from mercmac.vm import Machine, Options
 from mercmac.vm import reports
+from mercmac.vm.assemble import DIRECT
 
 REPORT_END = b"\r\n\x03"  # MS176E §6.1.3: CR LF ETX after every report
 CHAR_GAP_S = 0.020  # MS176E §2 notes: firmware 1.xx drops a line whose characters are > 20 ms apart
 MAX_COMMANDS = 16  # MS176E §3.8: up to 16 base commands per macro
-# TS error codes (MS176E §6.4 TS, block 6 / block 3)
-ERR_TIMEOUT, ERR_MACRO_RANGE, ERR_MACRO_COMMAND, ERR_COMMAND = 0x01, 0x04, 0x05, 0x06
+# TS error codes (MS176E §6.4 TS, block 6 / block 3); the C-663 list ends at 06 too
+ERR_TIMEOUT, ERR_OVERFLOW, ERR_STORAGE = 0x01, 0x02, 0x03
+ERR_MACRO_RANGE, ERR_MACRO_COMMAND, ERR_COMMAND = 0x04, 0x05, 0x06
+# The manual gives no size for the command buffer. The longest legal line is an MD line of
+# 16 commands with the longest arguments, "MD31," + 16 x "MA-1073741823" + 15 commas = 228
+# characters; 256 holds it with room for a few blanks. A longer line is error 02 "RS-232
+# overflow" (§6.4 TS) and the rest of it is dropped up to its CR.
+MAX_LINE = 256
+LINES_KEPT = 10_000  # `lines` keeps the most recent ones: an emulator may run for weeks
 _MACRO_COMMANDS = {"MD", "RM", "RMALL", "RZ", "TM", "TZ", "VE"}
-_TOKEN = re.compile(r"^([A-Z]+\??)([+-]?\d+)?$")
+_TOKEN = re.compile(r"^([A-Z]+\??)([+-]?[0-9]+)?$")
+_STATE_KEYS = ("model", "macros")
+log = logging.getLogger(__name__)
+
+
+class StateError(UsageError):
+    """A `--state` file the emulator cannot read or keep; it is left as it is (exit 2)."""
+
+
+class BadLine(ValueError):
+    """A command line the controller refuses (error 05 in MD, 06 in direct mode); says why."""
 
 
 @dataclass(slots=True)
@@ -55,8 +80,8 @@ class VirtualController:
                  state: Path | None = None):
         self.model, self.address, self.firmware = model, address, firmware
         self.faults = faults or Faults()
-        self.state = state
-        self.lines: list[str] = []  # every command line received, for tests and benchmarks
+        self.state = _state_target(state) if state else None
+        self.lines: deque[str] = deque(maxlen=LINES_KEPT)  # command lines, for tests and benchmarks
         self.md_count = 0
         self.busy_until = 0.0  # while storing a macro, further bytes wait in the input buffer
         self._held = bytearray()
@@ -64,15 +89,17 @@ class VirtualController:
         self.selected = False
         self._out = bytearray()
         self._line = bytearray()
+        self._overflow = False  # the line outgrew MAX_LINE: drop bytes up to its CR
+        self._bugs: set[str] = set()  # failures already logged, each once
         self._last_char_at = 0.0
         self._last_line: str | None = None
         self._awaiting_address = False
         self._now = 0.0
         self.machine = Machine(model=model, options=Options(address=address),
                                on_report=lambda t_ms, text: self.report(text))
-        stored = load_state(state) if state and state.exists() else dict(macros or {})
-        self.machine.load(Program({s: _macro(s, ops) for s, text in stored.items()
-                                   if (ops := _ops(text, s, model)) is not None}, model))
+        exists = self.state is not None and self.state.exists()
+        self._store(load_state(self.state, model) if exists else dict(macros or {}))
+        self._saved = self.macros  # what the state file holds
         self.power_on(0.0)
 
     # -- time and bytes ---------------------------------------------------
@@ -88,21 +115,23 @@ class VirtualController:
 
     def power_on(self, now: float) -> None:
         """Deselected, defaults restored, macro 0 started if stored (MS176E §3.1, §3.8.5)."""
-        self.machine.run_until(now * 1000)
+        self._run(now)
         self.selected, self._awaiting_address = False, False
         self._line.clear()
+        self._overflow = False
         self._last_line = None
-        self.machine.power_on()
+        self._safely("power-on", self.machine.power_on)
         self._self_select()
 
     def tick(self, now: float) -> None:
         """Let running macros advance to wall time `now` (seconds since power-on)."""
-        self.machine.run_until(now * 1000)
+        self._run(now)
         self._self_select()
         self._now = now
         while self._held and now >= self.busy_until and not self.vanished:
-            byte = self._held.pop(0)
-            self._byte(byte, now)
+            byte = self._held[0]
+            del self._held[0]  # O(1) at the front of a bytearray; pop(0) copies the rest
+            self._safely(f"byte 0x{byte:02X}", self._byte, byte, now)
 
     def take(self) -> bytes:
         """Bytes waiting to go to the host."""
@@ -122,6 +151,25 @@ class VirtualController:
         if self.selected and not self.faults.silent:
             self._out += text.encode("latin-1") + REPORT_END
 
+    def _run(self, now: float) -> None:
+        """Advance the VM to wall time `now`; a failure stops the macro, not the controller."""
+        self._safely("a running macro", self.machine.run_until, now * 1000)
+
+    def _safely(self, what: str, work: Callable, *args) -> None:
+        """Run one step of the firmware; a bug in it is error 06 and a message, never a crash."""
+        try:
+            work(*args)
+        except Exception as e:  # noqa: BLE001 - the controller must go on serving
+            self.machine.stop()
+            self.machine.error = ERR_COMMAND
+            self._log_once(f"emulator: {what} failed ({type(e).__name__}: {e}); "
+                           "answered with error 06 and went on")
+
+    def _log_once(self, message: str) -> None:
+        if message not in self._bugs:
+            self._bugs.add(message)
+            log.error(message, exc_info=log.isEnabledFor(logging.DEBUG))
+
     def _self_select(self) -> None:
         """SCn in the autostart macro selects the controller (MS176E §3.1.2)."""
         if self.machine.params.pop("SC", None) == self.address:
@@ -135,6 +183,7 @@ class VirtualController:
             self._awaiting_address = False
             self.selected = chr(byte).upper() == protocol.ADDRESS_CHARS[self.address]
             self._line.clear()
+            self._overflow = False
             return
         if byte == protocol.SELECT:
             self._awaiting_address = True
@@ -142,7 +191,7 @@ class VirtualController:
         if not self.selected or byte in (protocol.NUL, protocol.LF):
             return  # MS176E §5.1: deselected, everything but address codes is ignored
         char = chr(byte)
-        if not self._line and char in SINGLE_CHARS:
+        if not self._line and not self._overflow and char in SINGLE_CHARS:
             self._single(char)  # MS176E §6.3: executed at once, a macro keeps running
         elif byte == protocol.CR:
             self._end_of_line(now)
@@ -151,14 +200,28 @@ class VirtualController:
 
     def _char(self, byte: int, now: float) -> None:
         self.machine.stop()  # MS176E §3.8.3, §6.1.1: any other character stops a macro
-        if self._line and self._gap_limited() and now - self._last_char_at > CHAR_GAP_S:
+        if (self._line or self._overflow) and self._timed_out(now):
             self._line.clear()  # firmware 1.xx: characters too far apart, line dropped
+            self._overflow = False
             self.machine.error = ERR_TIMEOUT
-        self._line.append(byte)
         self._last_char_at = now
+        if self._overflow:
+            return  # the rest of an overlong line goes nowhere
+        if len(self._line) >= MAX_LINE:
+            self._line.clear()
+            self._overflow = True
+            self.machine.error = ERR_OVERFLOW
+            return
+        self._line.append(byte)
+
+    def _timed_out(self, now: float) -> bool:
+        return self._gap_limited() and now - self._last_char_at > CHAR_GAP_S
 
     def _end_of_line(self, now: float) -> None:
-        if self._line and self._gap_limited() and now - self._last_char_at > CHAR_GAP_S:
+        if self._overflow:  # the overlong line is not executed, nor repeated by a bare CR
+            self._overflow, self._last_line = False, None
+            return
+        if self._line and self._timed_out(now):
             self._line.clear()
             self.machine.error = ERR_TIMEOUT
             return
@@ -193,19 +256,25 @@ class VirtualController:
 
     def _execute(self, text: str, now: float) -> None:
         self.lines.append(text)
-        line = re.sub(r"\s+", "", text.upper())
+        self._safely(f"the line {text[:40]!r}", self._command, _canonical(text), now)
+        self._save()
+
+    def _command(self, line: str, now: float) -> None:
+        """One command line; a refused one is error 06 (§6.4 TS) and changes nothing."""
         if line.startswith("MD"):
             self._define(line)
             return
-        tokens = [t for t in line.split(",") if t]
-        if tokens and all(_split(t)[0] in _MACRO_COMMANDS for t in tokens):
-            for token in tokens:
-                self._macro_command(*_split(token), now)
-        elif (ops := _ops(line, -1, self.model)) is not None:
-            self.machine.execute_line(ops)
-            self.machine.run_until(now * 1000)  # reports of the line come at once
-        else:
+        try:
+            ops = _ops(line, DIRECT)
+        except BadLine:
             self.machine.error = ERR_COMMAND
+            return
+        if all(op.mnemonic in _MACRO_COMMANDS for op in ops):
+            for op in ops:
+                self._macro_command(op.mnemonic, op.arg, now)
+        else:
+            self.machine.execute_line(ops)
+            self._run(now)  # reports of the line come at once
 
     def _define(self, line: str) -> None:
         """MDn,...: store silently, overwriting (MS176E §3.8.1, §6.4 MD)."""
@@ -213,15 +282,14 @@ class VirtualController:
         line = self._lose_character(line)
         head, _, body = line.partition(",")
         slot = _number(head[2:])
-        ops = _ops(body, slot, self.model) if slot is not None and 0 <= slot <= 31 else None
         if slot is None or not 0 <= slot <= 31:
             self.machine.error = ERR_MACRO_RANGE
-        elif ops is None:
-            self.machine.error = ERR_MACRO_COMMAND
         else:
-            self.machine.define(slot, ops)
-            self._save()
-            self.busy_until = self._now + self.faults.md_delay
+            try:
+                self.machine.define(slot, _ops(body, slot))
+                self.busy_until = self._now + self.faults.md_delay
+            except BadLine:
+                self.machine.error = ERR_MACRO_COMMAND
         if self.faults.vanish_after_md is not None and self.md_count >= self.faults.vanish_after_md:
             self.vanished = True
 
@@ -246,7 +314,6 @@ class VirtualController:
         else:  # RZ, RMn, RM, RMALL (§6.4): the VM erases; the state file follows
             self.machine.execute_line([Op(name, arg)])
             self.machine.run_until(now * 1000 + 1)
-            self._save()
 
     def _tell(self, slots: list[int], listing: bool = False) -> None:
         """TM/TZ answers, framed as `Faults` says (SPEC §4 leaves both open)."""
@@ -262,8 +329,24 @@ class VirtualController:
                 self.report(line)
 
     def _save(self) -> None:
-        if self.state:
-            save_state(self.state, self.macros, self.model)
+        """Write a changed flash memory to the state file; if that fails, the change is undone."""
+        macros = self.macros
+        if self.state is None or macros == self._saved:
+            self._saved = macros
+            return
+        try:
+            save_state(self.state, macros, self.model)
+        except OutputError as e:  # the folder went away, the disk is full, ...
+            log.error("emulator: %s; error 03, the macros stay as they were", e.message)
+            self.machine.error = ERR_STORAGE  # MS176E §6.4 TS: 03 macro storage full
+            self._store(self._saved)
+        else:
+            self._saved = macros
+
+    def _store(self, macros: dict[int, str]) -> None:
+        """Make the flash memory hold exactly these macros."""
+        self.machine.load(Program({s: _macro(s, _ops(text, s)) for s, text in macros.items()},
+                                  self.model))
 
 
 def _split(token: str) -> tuple[str, int | None]:
@@ -274,49 +357,108 @@ def _split(token: str) -> tuple[str, int | None]:
 
 
 def _number(text: str) -> int | None:
-    try:
-        return int(text) if text else None
-    except ValueError:
-        return None
+    """'12', '+5', '-3' as an int; anything else (also '1_0', '') None."""
+    return int(text) if re.fullmatch(r"[+-]?[0-9]+", text) else None
 
 
-def _ops(body: str, slot: int, model: str) -> list[Op] | None:
-    """The base commands of a line, or None if one is unknown or malformed (error 05/06)."""
-    tokens = body.split(",") if body else []
-    if not tokens or len(tokens) > MAX_COMMANDS:
-        return None
-    ops = []
-    for token in tokens:
-        if token == "":
-            continue  # `DI,` in MMCRun files (MS176E §3.8.6 Example 4)
-        m = _TOKEN.match(token)
-        spec = COMMANDS.get(m.group(1)) if m else None
-        if spec is None or (slot >= 0 and not spec.storable):
-            return None
-        arg = _number(m.group(2) or "")
-        if (arg is None and spec.arg is Arg.REQUIRED) or (arg is not None and spec.arg is Arg.NONE):
-            return None
-        ops.append(Op(spec.mnemonic, arg))
+def _canonical(text: str) -> str:
+    """A line as the firmware reads it: upper case, blanks dropped (MS176E §6.1.2)."""
+    return re.sub(r"\s+", "", text.upper())
+
+
+def _ops(body: str, slot: int) -> list[Op]:
+    """The base commands of a line; BadLine names the first that is unknown or out of range."""
+    ops = [_op(token, slot) for token in body.split(",") if token]  # `DI,`: MS176E §3.8.6 Ex. 4
+    if not ops:
+        raise BadLine("no command")
+    if len(ops) > MAX_COMMANDS:
+        raise BadLine(f"{len(ops)} commands, more than the {MAX_COMMANDS} a macro holds")
     return ops
+
+
+def _op(token: str, slot: int) -> Op:
+    """One command, its argument checked against the command table (as `mercmac check` does)."""
+    m = _TOKEN.match(token)
+    spec = COMMANDS.get(m.group(1)) if m else None
+    if spec is None:
+        raise BadLine(f"{token[:20]!r} is not a command")
+    if slot != DIRECT and not spec.storable:
+        raise BadLine(f"{spec.mnemonic} cannot stand in a macro")
+    arg = _number(m.group(2) or "")
+    missing = arg is None and spec.arg is Arg.REQUIRED
+    if missing or (arg is not None and (spec.arg is Arg.NONE or not spec.in_range(arg))):
+        raise BadLine(f"{spec.expects()}, not {token[:20]!r}")
+    return Op(spec.mnemonic, arg)
 
 
 def _macro(slot: int, ops: list[Op]) -> Macro:
     return Macro(slot, f"MC{slot:02d}", ops, origin="stored")
 
 
-def load_state(path: Path) -> dict[int, str]:
-    """The macros of a `--state` file; a missing or broken file is an empty controller."""
+def _state_target(path: Path) -> Path:
+    """PATH if the state can be kept there; checked before serving, not mid-flash."""
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-        return {int(k): str(v) for k, v in data.get("macros", {}).items() if 0 <= int(k) <= 31}
-    except (OSError, ValueError, AttributeError):
-        return {}
+        writable_target(path)
+    except OutputError as e:
+        raise StateError(f"--state: {e.message}", hint="give a file in a folder that exists "
+                         "and can be written; it is created on the first write") from None
+    return path
+
+
+def load_state(path: Path, model: str) -> dict[int, str]:
+    """The macros of a `--state` file, read as the controller reads MD lines; else StateError."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"), object_pairs_hook=_no_duplicates)
+    except UnicodeDecodeError:
+        raise _unreadable(path, "it is not UTF-8 text") from None
+    except ValueError as e:
+        raise _unreadable(path, f"it is not valid JSON ({e})") from None
+    except OSError as e:
+        raise _unreadable(path, e.strerror or str(e)) from None
+    if not isinstance(data, dict):
+        raise _unreadable(path, "it is not a JSON object")
+    if unknown := [k for k in data if k not in _STATE_KEYS]:
+        raise _unreadable(path, f"unknown key {unknown[0]!r} (expected {', '.join(_STATE_KEYS)})")
+    if data.get("model", model) != model:
+        raise StateError(f"the state file {path} holds the macros of a {data['model']}, "
+                         f"not of a {model}; it is left as it is",
+                         hint=f"run with --target {data['model']}, or give another --state file")
+    macros = data.get("macros", {})
+    if not isinstance(macros, dict):
+        raise _unreadable(path, "'macros' is not an object of macro numbers and lines")
+    return dict(_state_entry(path, key, text) for key, text in macros.items())
+
+
+def _no_duplicates(pairs: list[tuple[str, object]]) -> dict:
+    """A JSON object; a key given twice would silently lose one of the two."""
+    data = {}
+    for key, value in pairs:
+        if key in data:
+            raise ValueError(f"{key!r} appears twice")
+        data[key] = value
+    return data
+
+
+def _state_entry(path: Path, key: str, text: object) -> tuple[int, str]:
+    """One stored macro: upper-cased and checked as an MD line would be (MS176E §6.4 MD)."""
+    slot = _number(key) if key.isascii() else None
+    if slot is None or not 0 <= slot <= 31:
+        raise _unreadable(path, f"{key!r} is not a macro number 0-31")
+    if not isinstance(text, str):
+        raise _unreadable(path, f"macro {slot} is not a line of text")
+    try:
+        ops = _ops(_canonical(text), slot)
+    except BadLine as e:
+        raise _unreadable(path, f"macro {slot} is not a valid macro line: {e}") from None
+    return slot, ",".join(op.text for op in ops)
+
+
+def _unreadable(path: Path, why: str) -> StateError:
+    return StateError(f"cannot read the state file {path}: {why}; it is left as it is",
+                      hint="repair it, or move it aside to start with an empty controller")
 
 
 def save_state(path: Path, macros: dict[int, str], model: str) -> None:
-    """Keep the flash memory across runs; written atomically like a flash page."""
+    """Keep the flash memory across runs: the whole file or the old one (OutputError)."""
     data = {"model": model, "macros": {str(k): v for k, v in sorted(macros.items())}}
-    fd, tmp = tempfile.mkstemp(prefix=".mercmac-state-", dir=path.parent)
-    with os.fdopen(fd, "w", encoding="utf-8") as f:
-        json.dump(data, f, indent=1)
-    os.replace(tmp, path)
+    write_text(path, json.dumps(data, indent=1) + "\n")

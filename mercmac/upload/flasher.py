@@ -70,6 +70,7 @@ class FlashResult:
 def flash(controller: Controller, identity: Identity, program: Program,
           options: FlashOptions, notify: Notify = lambda e: None) -> FlashResult:
     """Read back, back up, write and verify; FlashFailed names the state on any failure."""
+    result = None
     try:
         stored = controller.read_all()  # TM, TZ (SPEC §4 rule 3)
         plan = make_plan(program, stored, erase_unused=options.erase_unused)
@@ -77,11 +78,13 @@ def flash(controller: Controller, identity: Identity, program: Program,
         if options.dry_run:
             return result
         result.backup = _save_backup(controller, identity, stored, options.backup)
+        notify(Event("backup", f"backup of {len(stored)} stored macros: {result.backup}"))
     except ControllerError as e:
         raise refusal(controller, e) from None
     except KeyboardInterrupt:
-        raise FlashInterrupted("interrupted before the first write; nothing was written") from None
-    notify(Event("backup", f"backup of {len(stored)} stored macros: {result.backup}"))
+        saved = f"; backup: {result.backup}" if result and result.backup else ""
+        raise FlashInterrupted(f"interrupted before the first write; nothing was written{saved}") \
+            from None
     run = _Run(controller, plan, notify, result)
     run.execute()
     if options.reset:
@@ -121,14 +124,23 @@ class _Run:
                 self.current = None
                 self.notify(Event("verified", f"{step.describe}: verified", i + 1, total))
         except KeyboardInterrupt:
-            raise FlashInterrupted(self._report("interrupted (Ctrl-C)", alive=True),
-                                   hint=self._hint()) from None
+            kind, cause, alive = FlashInterrupted, "interrupted (Ctrl-C)", True
         except _Mismatch as e:
             self.verify_failed = True
-            raise FlashFailed(self._report(str(e), alive=True), hint=self._hint()) from None
+            kind, cause, alive = FlashFailed, e.args[0], True
         except ControllerError as e:
-            alive = not isinstance(e, LinkLost)
-            raise FlashFailed(self._report(_cause(e), alive=alive), hint=self._hint()) from None
+            kind, cause, alive = FlashFailed, _cause(e), not isinstance(e, LinkLost)
+        else:
+            return
+        # Inline, with no call before the `try`: a second Ctrl-C, pending since the first,
+        # fires at the first call and must land inside it. It skips the tidy-up, never the report.
+        while True:
+            try:
+                stopped = kind(self._report(cause, alive=alive), hint=self._hint())
+                break
+            except KeyboardInterrupt:
+                alive = False  # no more talking to the controller: just say where things stand
+        raise stopped from None
 
     def reset(self) -> None:
         try:
@@ -136,6 +148,11 @@ class _Run:
         except ControllerError as e:
             raise FlashFailed(f"all macros are written and verified, but RT failed: {_cause(e)}",
                               hint="power-cycle the controller to start macro 0") from None
+        except KeyboardInterrupt:
+            raise FlashInterrupted(f"all macros are written and verified (backup: "
+                                   f"{self.result.backup}); interrupted while sending RT, so "
+                                   f"macro 0 may not have started",
+                                   hint="power-cycle the controller to start macro 0") from None
         self.notify(Event("reset", "RT sent: the controller restarts and runs macro 0"))
 
     def _apply(self, step: Step) -> None:

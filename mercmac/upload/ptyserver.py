@@ -6,6 +6,7 @@ a `vanish` fault closes both ends to look like a pulled USB cable.
 """
 from __future__ import annotations
 
+import logging
 import os
 import select
 import threading
@@ -15,6 +16,7 @@ import tty
 from mercmac.upload.emulator import VirtualController
 
 TICK_S = 0.002  # how often running macros advance when no bytes arrive
+log = logging.getLogger(__name__)
 
 
 class PtyServer:
@@ -32,6 +34,7 @@ class PtyServer:
         self._lock = threading.Lock()
         self._thread: threading.Thread | None = None
         self._t0 = time.monotonic()
+        self._failures: set[str] = set()  # logged once each, however often they recur
 
     def __enter__(self) -> "PtyServer":
         self.start()
@@ -47,21 +50,31 @@ class PtyServer:
         self._thread.start()
 
     def serve_forever(self) -> None:
-        while not self._stop.is_set():
+        while not self._stop.is_set() and self._master is not None:
             ready, _, _ = select.select([self._master], [], [], TICK_S)
             now = time.monotonic() - self._t0
             data = self._read() if ready else b""
             with self._lock:
-                if data:
-                    self.controller.receive(data, now)
-                self.controller.tick(now)
-                out = self.controller.take()
-                vanished = self.controller.vanished
+                out, vanished = self._serve(data, now)
             if out:
                 self._write(out)
             if vanished:
                 self._close_fds()
                 return
+
+    def _serve(self, data: bytes, now: float) -> tuple[bytes, bool]:
+        """One turn of the controller; a bug in it is logged, and serving goes on."""
+        try:
+            if data:
+                self.controller.receive(data, now)
+            self.controller.tick(now)
+            return self.controller.take(), self.controller.vanished
+        except Exception as e:  # noqa: BLE001 - an emulator that dies loses every macro
+            message = f"emulator: {type(e).__name__}: {e}; still serving"
+            if message not in self._failures:
+                self._failures.add(message)
+                log.error(message, exc_info=log.isEnabledFor(logging.DEBUG))
+            return b"", False
 
     def call(self, fn):
         """Run `fn(controller)` between bytes, e.g. to press a button from a test."""

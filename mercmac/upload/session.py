@@ -9,7 +9,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Callable, Iterator
 
-from mercmac.upload.controller import BadReply, Controller, ControllerError, LinkLost, NoAnswer
+from mercmac.upload.controller import BadReply, Controller, ControllerError, Flood, LinkLost, NoAnswer
 from mercmac.upload.errors import PortError, Refused
 from mercmac.upload.protocol import Version
 from mercmac.upload.transport import DEFAULT_BAUD, PortUnavailable, Timing, Transport
@@ -57,6 +57,10 @@ def refusal(controller: Controller, e: ControllerError) -> Refused:
     if isinstance(e, NoAnswer):
         return Refused(f"nothing answers at {where} ({e}); nothing was written",
                        hint=_silence_hint(controller))
+    if isinstance(e, Flood):
+        return Refused(f"the device at {where} does not stop sending: {e}; nothing was written",
+                       hint="a controller whose macro reports without pause, or a device that is "
+                            "not a Mercury controller: power-cycle it, or check the port")
     if isinstance(e, BadReply):
         return Refused(f"the device at {where} does not answer like a Mercury controller: "
                        f"{e}; nothing was written",

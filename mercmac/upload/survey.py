@@ -4,8 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from mercmac.upload import backup
-from mercmac.upload.controller import Controller, ControllerError
-from mercmac.upload.controller import LinkLost
+from mercmac.upload.controller import BadReply, Controller, ControllerError, Flood, LinkLost
 from mercmac.upload.errors import UploadError
 from mercmac.upload.protocol import Status, Version
 from mercmac.upload.session import Identity, identify, refusal
@@ -41,34 +40,51 @@ class Found:
     """One address that answered a scan."""
 
     address: int
-    status: Status
+    status: Status | None  # None when what came was not a status report (quoted in `note`)
     version: Version | None  # None when a running macro was left alone, or VE was garbled
     note: str = ""
 
     @property
     def model(self) -> str:
-        return self.version.model if self.version else self.status.layout
+        if self.version:
+            return self.version.model
+        return self.status.layout if self.status else "?"
 
 
 def scan(transport: Transport, addresses=range(16), *, stop: bool = False) -> list[Found]:
-    """Which addresses answer `%`; VE for those not running a macro (or all, with stop)."""
+    """Which addresses answer `%`; VE for those not running a macro (or all, with stop).
+
+    An address whose answer is not a status report is listed with what came; a flood
+    of such replies ends the scan there, as the line carries nothing readable.
+    """
     found = []
     for address in addresses:
         controller = Controller(transport, address)
+        status = None
         try:
             controller.select()  # 0x01 + address: the others deselect (MS176E §3.2)
-            status = controller.status()  # '%' does not stop a running macro (§6.3)
-            if status is None:
-                continue
+            status = controller.probe()  # '%' does not stop a running macro (§6.3)
             if status.macro_running and not stop:
                 found.append(Found(address, status, None, "macro running, left alone"))
                 continue
             found.append(Found(address, status, controller.identify()))
         except LinkLost as e:
             raise UploadError(f"scan stopped at address {address}: {e}") from None
-        except ControllerError as e:
-            found.append(Found(address, status, None, f"VE: {e}"))
+        except Flood as e:
+            found.append(Found(address, status, None,
+                               f"{'VE: ' if status else ''}{e}; scan stopped here"))
+            break
+        except BadReply as e:
+            found.append(Found(address, status, None, f"VE: {e}" if status else str(e)))
+        except ControllerError as e:  # NoAnswer: nobody at this address
+            if status:
+                found.append(Found(address, status, None, f"VE: {e}"))
     return found
+
+
+def answered(found: list[Found]) -> bool:
+    """Whether any controller answered the scan with a status report."""
+    return any(f.status for f in found)
 
 
 @dataclass(frozen=True, slots=True)

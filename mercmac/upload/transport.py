@@ -6,6 +6,7 @@ program left open cannot interleave its bytes with an upload.
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from typing import Callable
@@ -14,6 +15,7 @@ from mercmac.upload.protocol import ProtocolError, ReportSplitter
 
 DEFAULT_BAUD = 9600  # MS176E §3.3: MMCRun's rate, DIP switches 5 and 6 ON
 POLL_S = 0.02  # how long one pyserial read may block; bounds the reaction to Ctrl-C
+LONGEST_REPLY = 4096  # bytes: a TM listing of 31 full macros stays under this
 
 
 class TransportError(Exception):
@@ -29,11 +31,12 @@ class PortLost(TransportError):
 
 
 class ReadTimeout(TransportError):
-    """No complete report came in time; `partial` holds what did come."""
+    """No complete report came in time; `partial` holds what did come, `endless` is
+    true when bytes kept coming (a flood without ETX) rather than falling silent."""
 
-    def __init__(self, message: str, partial: str = ""):
+    def __init__(self, message: str, partial: str = "", endless: bool = False):
         super().__init__(message)
-        self.partial = partial
+        self.partial, self.endless = partial, endless
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,9 +46,16 @@ class Timing:
     timeout: float = 1.0  # silence after which a reply is given up (flash writes take a while)
     settle: float = 0.25  # quiet time after an ETX that ends a multi-report TM listing
 
-    def budget(self, baud: int) -> float:
-        """Longest time one reply may take: a timeout plus a full-size report at `baud`."""
-        return self.timeout + 4096 * 10 / max(baud, 300) + 2.0
+    def __post_init__(self) -> None:
+        # nan compares false with everything: a nan timeout would never expire
+        for name in ("timeout", "settle"):
+            if not 0 < getattr(self, name) < math.inf:
+                raise ValueError(f"{name} must be a positive number of seconds, "
+                                 f"not {getattr(self, name)!r}")
+
+    def budget(self, baud: int, size: int = LONGEST_REPLY) -> float:
+        """Longest time one exchange may take: a timeout plus `size` bytes at `baud`."""
+        return self.timeout + size * 10 / max(baud, 300) + 2.0
 
 
 class Transport:
@@ -97,11 +107,12 @@ class Transport:
         self._splitter.clear()
         self._reports.clear()
 
-    def read_report(self, timeout: float | None = None) -> str:
-        """The next report (text before ETX); ReadTimeout after `timeout` s of silence."""
+    def read_report(self, timeout: float | None = None, deadline: float | None = None) -> str:
+        """The next report (text before ETX); ReadTimeout after `timeout` s of silence,
+        or at `deadline` (time.monotonic) or the budget however many bytes still come."""
         limit = self.timing.timeout if timeout is None else timeout
-        quiet_since = time.monotonic()
-        hard_stop = quiet_since + self.timing.budget(self.baud)
+        started = quiet_since = time.monotonic()
+        hard_stop = min(started + self.timing.budget(self.baud), deadline or math.inf)
         while True:
             if self._reports:
                 return self._reports.pop(0)
@@ -112,9 +123,16 @@ class Transport:
                 try:
                     self._reports.extend(self._splitter.feed(data))
                 except ProtocolError as e:
-                    raise ReadTimeout(str(e), e.reply or "") from None
-            elif now - quiet_since >= limit or now >= hard_stop:
+                    raise ReadTimeout(str(e), e.reply or "", endless=True) from None
+                if self._reports:
+                    continue
+            if now - quiet_since >= limit:
                 raise ReadTimeout(f"no complete reply within {limit:g} s", self._splitter.pending())
+            if now >= hard_stop:  # bytes kept coming: never an ETX, or reports the caller skips
+                pending = self._splitter.pending()
+                what = f"{now - started:.1f} s of bytes without an end of report (ETX)" if pending \
+                    else "replies kept coming, none of them the answer"
+                raise ReadTimeout(what, pending, endless=True)
 
     def _read_some(self) -> bytes:
         try:

@@ -1,16 +1,20 @@
 """The controller's clock: integer microseconds and the command cycle (SPEC §3 Time)."""
 from __future__ import annotations
 
-from mercmac.errors import UsageError
+
+class CycleError(ValueError):
+    """A command cycle the clock cannot count in (not finite, or outside 1 us to 1 s)."""
 
 
 class Clock:
     """Now, in us since power-on, and how long one executed command takes."""
 
     def __init__(self, cycle_ms: float = 1.0):
-        cycle_us = round(cycle_ms * 1000)
+        # bounded before rounding: round() fails on nan and inf, and 1e308 ms * 1000 is inf
+        sane = isinstance(cycle_ms, (int, float)) and 0 < cycle_ms <= 2000
+        cycle_us = round(cycle_ms * 1000) if sane else 0
         if not 1 <= cycle_us <= 1_000_000:
-            raise UsageError(f"command cycle {cycle_ms} ms: use 0.001 ms to 1000 ms")
+            raise CycleError(f"command cycle {cycle_ms!r} ms: use 0.001 ms to 1000 ms")
         self.cycle = cycle_us
         self.now = 0
 

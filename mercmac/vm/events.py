@@ -101,13 +101,18 @@ class ProgramEnded:
 
 @dataclass(frozen=True, slots=True)
 class FastForwarded:
-    """`passes` identical passes of a loop skipped from t to t_to, `period` us each."""
+    """`passes` identical passes of a loop skipped from t to t_to, `period` us each.
+
+    `shape` is what each skipped pass emitted (reports, output changes, inner
+    skips) relative to its start; fastforward.count and expand read it.
+    """
 
     t: int
     t_to: int
     passes: int
     period: int
     loop: Where
+    shape: tuple = ()
 
 
 @dataclass(frozen=True, slots=True)

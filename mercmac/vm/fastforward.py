@@ -7,11 +7,24 @@ between and no input change, the next passes are copies of that one: each
 lasts `period` and does the same, until an input changes, the run ends or the
 RP counter runs out. So they can be skipped with the clock and counter advanced
 exactly.
+
+A pass may also emit reports and output changes (issue 7, item 7: a blinking
+LED, `every 20ms { TT }`): when two passes in a row start from the same state
+and emit the same things at the same offsets (the same `shape`), the later
+passes emit them too, and a skip carries that shape so that its observer can
+count (and list, up to its cap) exactly what plain stepping would have emitted.
+Passes that move, report a hazard or see an input change never repeat this way.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Iterator
+
+from mercmac.vm import events as ev
+
+REPORT, OUTPUTS, SKIP = "report", "outputs", "skip"  # what a shape's items are
+FLOW = (ev.MacroEntered, ev.MacroLeft, ev.Executed)  # control flow: repeats with the pass
 
 
 @dataclass(frozen=True, slots=True)
@@ -20,9 +33,10 @@ class Visit:
 
     key: tuple | None  # state without clock and own counter; None when moving
     wake: int  # when the pass starts, us
-    effects: int  # observable events so far
     inputs: int  # input change count so far
     waits: int  # wait instructions executed so far
+    logged: int  # effects logged so far (the machine's effect log)
+    shape: tuple | None  # what the pass that ended here emitted; None: unknown or unrepeatable
 
 
 class Anchors:
@@ -49,10 +63,63 @@ class Anchors:
         self.visits.clear()
 
 
+def logged(event) -> bool:
+    """Whether an event is part of a pass's effects: all but flow, and skips that emitted."""
+    if isinstance(event, ev.FastForwarded):
+        return bool(event.shape)
+    return not isinstance(event, FLOW)
+
+
+def shape(events: list, start: int) -> tuple | None:
+    """A pass's effects relative to its start; None if one of them cannot repeat."""
+    items = []
+    for e in events:
+        if type(e) is ev.Reported:
+            items.append((REPORT, e.t - start, e.text, e.where))
+        elif type(e) is ev.OutputsChanged:
+            items.append((OUTPUTS, e.t - start, e.pattern))
+        elif type(e) is ev.FastForwarded:
+            items.append((SKIP, e.t - start, e.passes, e.period, e.shape, e.loop))
+        else:  # motion, inputs, hazards: not the same in the next pass
+            return None
+    return tuple(items)
+
+
 def same_pass(previous: Visit, now: Visit) -> bool:
-    """True when the pass from `previous` to `now` will repeat exactly."""
-    return (now.key is not None and now.key == previous.key and now.effects == previous.effects
-            and now.inputs == previous.inputs and now.wake > previous.wake)
+    """True when the pass from `previous` to `now` will repeat exactly.
+
+    Two passes in a row start from the same state and emit the same (shape is only
+    known when the pass started from the state it ended in): what a pass does
+    then depends only on the jumping RP's own counter, which a TI would show (it
+    differs from pass to pass) and which `remaining` bounds. Two, not one, so
+    that no loop inside the pass first found a busy loop in the passes skipped.
+    """
+    return (now.key is not None and now.key == previous.key and now.inputs == previous.inputs
+            and now.wake > previous.wake and now.shape is not None
+            and now.shape == previous.shape)
+
+
+def count(shape: tuple, kind: str) -> int:
+    """How many reports (or output changes) one pass of `shape` emits."""
+    return sum(1 if item[0] == kind else item[2] * count(item[4], kind)
+               for item in shape if item[0] in (kind, SKIP))
+
+
+def expand(shape: tuple, start: int, period: int, passes: int, kind: str) -> Iterator:
+    """The events of `kind` that `passes` passes of `shape` from `start` emit, in time order."""
+    items = [item for item in shape
+             if item[0] == kind or (item[0] == SKIP and count(item[4], kind))]
+    if not items:
+        return
+    for p in range(passes):
+        base = start + p * period
+        for item in items:
+            if item[0] == REPORT:
+                yield ev.Reported(base + item[1], item[2], item[3])
+            elif item[0] == OUTPUTS:
+                yield ev.OutputsChanged(base + item[1], item[2])
+            else:
+                yield from expand(item[4], base + item[1], item[3], item[2], kind)
 
 
 def skippable(previous: Visit, now: Visit, horizon: float, remaining: float) -> int:

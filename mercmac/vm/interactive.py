@@ -18,6 +18,8 @@ from mercmac.vm import events as ev
 from mercmac.vm.machine import Machine
 
 TICK_S = 0.05  # redraw period
+SLICE_MS = 100  # simulated time run between two looks at the wall clock
+MAX_SPEED = 1000.0  # 1000 s of a busy loop take more than 1 s to simulate; 1e308 overflows to inf
 HELP = "keys 1-4: press/release a button (5, 6: joystick, joystick button) - q: quit"
 CLEAR = "\r\x1b[K"  # carriage return, erase to the end of the line (ECMA-48 EL)
 SHOWN = (ev.InputChanged, ev.OutputsChanged, ev.Reported, ev.HazardFound, ev.MoveStarted,
@@ -28,10 +30,11 @@ def run(machine: Machine, *, speed: float = 1.0, stdin: IO | None = None,
         stdout: IO[str] | None = None) -> int:
     """Run the box until q; the terminal is put back as it was, whatever happens."""
     stdin, stdout = stdin or sys.stdin, stdout or sys.stdout
+    if not 0 < speed <= MAX_SPEED:  # also refuses nan
+        raise UsageError(f"--speed {speed:g}: use more than 0 and at most {MAX_SPEED:g} "
+                         "(simulated seconds per wall-clock second)")
     if not stdin.isatty():
         raise UsageError("--interactive needs a terminal on standard input")
-    if speed <= 0:
-        raise UsageError("--speed must be greater than 0")
     import termios
     import tty
 
@@ -54,7 +57,7 @@ def _loop(machine: Machine, speed: float, fd: int, out: IO[str]) -> int:
     start = time.monotonic()
     while True:
         ready, _, _ = select.select([fd], [], [], TICK_S)
-        machine.run_until((time.monotonic() - start) * 1000 * speed)
+        _advance(machine, (time.monotonic() - start) * 1000 * speed, time.monotonic() + TICK_S)
         for key in os.read(fd, 64).decode(errors="ignore") if ready else "":
             if key in "qQ":
                 _show(pending, machine, out)
@@ -63,6 +66,15 @@ def _loop(machine: Machine, speed: float, fd: int, out: IO[str]) -> int:
                 n = int(key)
                 machine.set_input(n, not machine.inputs[n])
         _show(pending, machine, out)
+
+
+def _advance(machine: Machine, t_ms: float, deadline: float) -> None:
+    """Run towards t_ms, but stop at the wall-clock deadline so that keys are read on time."""
+    while time.monotonic() < deadline:
+        until = min(t_ms, machine.now_ms + SLICE_MS)
+        machine.run_until(until)
+        if until == t_ms:
+            return
 
 
 def _show(pending: list, machine: Machine, out: IO[str]) -> None:

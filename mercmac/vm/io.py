@@ -1,7 +1,7 @@
 """The I/O lines: inputs 1-6 with their scheduled changes, outputs 1-4 (the C-170.PB LEDs)."""
 from __future__ import annotations
 
-import bisect
+import heapq
 import math
 
 INPUTS = range(1, 7)  # 1-4 pushbuttons, 5 joystick (ON above mid-scale), 6 joystick button
@@ -12,7 +12,10 @@ class Inputs:
 
     def __init__(self):
         self.state = [False] * 7  # index 0 unused
-        self._due: list[tuple[int, int, int, bool]] = []  # (t_us, order, input, on)
+        # changes by time, in scheduling order, and a heap of those times: a button script
+        # of 100,000 presses costs O(log n) per distinct time, not a list shift per change
+        self._due: dict[int, list[tuple[int, bool]]] = {}
+        self._times: list[int] = []
         self.version = 0  # bumps on every change: fast-forward must not skip one
 
     def __getitem__(self, n: int) -> bool:
@@ -20,18 +23,22 @@ class Inputs:
 
     def schedule(self, t_us: int, n: int, on: bool) -> None:
         """Set input n at time t_us; changes at the same time apply in scheduling order."""
-        bisect.insort(self._due, (t_us, len(self._due), n, on))
+        changes = self._due.get(t_us)
+        if changes is None:
+            changes = self._due[t_us] = []
+            heapq.heappush(self._times, t_us)
+        changes.append((n, on))
 
     def next_change(self) -> float:
-        return self._due[0][0] if self._due else math.inf
+        return self._times[0] if self._times else math.inf
 
     def pop_due(self, t_us: int) -> list[tuple[int, bool]]:
         """Changes due at or before t_us, removed from the schedule, that change a line."""
         changed = []
-        while self._due and self._due[0][0] <= t_us:
-            _, _, n, on = self._due.pop(0)
-            if self.set(n, on):
-                changed.append((n, on))
+        while self._times and self._times[0] <= t_us:
+            for n, on in self._due.pop(heapq.heappop(self._times)):
+                if self.set(n, on):
+                    changed.append((n, on))
         return changed
 
     def set(self, n: int, on: bool) -> bool:

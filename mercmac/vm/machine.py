@@ -14,6 +14,7 @@ from typing import Callable, Iterable
 from mercmac.commands import C663, COMMANDS, MAX_POSITION
 from mercmac.compiler.program import Op, Program
 from mercmac.vm import events as ev
+from mercmac.vm import fastforward as ff
 from mercmac.vm import reports
 from mercmac.vm.assemble import DIRECT, Chunk, assemble, assemble_ops
 from mercmac.vm.clock import Clock
@@ -29,6 +30,8 @@ from mercmac.vm.trigger import PULSE_US, Trigger
 INF = math.inf
 JT_US = 2_000_000  # §6.4 JT: "Executing the JT command takes about 2 seconds"
 BUSY_PASSES = 1000  # a loop without waits this long (or endless) is a busy loop hazard
+LOG_LIMIT = 100_000  # effects kept for comparing passes; a longer pass is not skipped
+FAST_FORWARD = ("off", "quiet", "all")  # skip no passes, passes that emit nothing, or any
 
 # §6.4 TS error codes
 E_WRONG_COMMAND, E_HARD_STOP, E_SERVO_OFF, E_JOYSTICK = 0x06, 0x07, 0x0A, 0x0B
@@ -56,17 +59,24 @@ class Machine:
                  cycle_ms: float = 1.0, options: Options | None = None,
                  on_report: Callable[[float, str], None] | None = None,
                  on_event: Callable[[object], None] | None = None, trace: bool = False,
-                 hardware: Hardware | None = None):
+                 hardware: Hardware | None = None, fast_forward: str = "quiet"):
         self.model = model_name(model or (program.target if program else None))
         self.options = options or Options()
         hw = hardware or Hardware.for_model(self.model, self.options, cycle_ms)
         self.clock, self.inputs, self.outputs = hw.clock, hw.inputs, hw.outputs
         self.axis, self.trigger = hw.axis, hw.trigger
         self.on_report, self.on_event, self.trace = on_report, on_event, trace
+        # "all" skips passes that report or switch outputs too: the observer must count
+        # them from FastForwarded.shape (the Recorder does; on_report gets each report)
+        if fast_forward not in FAST_FORWARD:
+            raise ValueError(f"fast_forward must be one of {FAST_FORWARD}")
+        self.fast_forward = fast_forward
+        self._log: list = []  # effects since _log_base: what passes emitted (fastforward.shape)
+        self._log_base = 0
         self.chunks: dict[int, Chunk] = {}
         self.anchors = Anchors()
         self.hazards = HazardLog()
-        self.effects = self.waits = 0
+        self.waits = 0
         self._horizon = INF
         self._reset_state()
         if program is not None:
@@ -379,7 +389,6 @@ class Machine:
         """Run an axis command now and tell the observer about the new profile."""
         t = self.clock.now
         command(t)
-        self.effects += 1
         self.mover = self._where(self.ip - 1)  # the command a limit hit will be blamed on
         self._emit(ev.MoveStarted(t, kind, self.axis.target,
                                   self.axis.arrival() if self.axis.moving(t) else t,
@@ -390,7 +399,6 @@ class Machine:
 
     def _define_home(self, value: int) -> None:
         self.axis.define_home(self.clock.now, value)
-        self.effects += 1
         self._emit(ev.HomeDefined(self.clock.now, value, self._where(self.ip - 1)))
 
     def _find_edge(self, mode: int) -> None:
@@ -432,7 +440,6 @@ class Machine:
         pattern = self.outputs.pattern(self.clock.now)
         if pattern != self.shown:
             self.shown = pattern
-            self.effects += 1
             self._emit(ev.OutputsChanged(self.clock.now, pattern))
 
     def _trigger(self, opcode: Opcode, value: int) -> None:
@@ -451,7 +458,6 @@ class Machine:
         self.wake = self.table_done
 
     def _report(self, text: str) -> None:
-        self.effects += 1
         t = self.clock.now
         self._emit(ev.Reported(t, text, self._where(self.ip - 1)))
         if self.on_report:
@@ -495,7 +501,6 @@ class Machine:
 
     def _input_changed(self, n: int, on: bool) -> None:
         t = self.clock.now
-        self.effects += 1
         self._emit(ev.InputChanged(t, n, on))
         if self.block and self.block[0] in ("WN", "WF") and self.block[1] == n:
             if on == (self.block[0] == "WN"):
@@ -512,7 +517,6 @@ class Machine:
         happened = self.axis.advance(t)
         if happened is None:
             return
-        self.effects += 1
         if happened[0] == "limit":
             self.error = E_HARD_STOP
             self._hazard("hard-limit", f"the stage hit the {happened[1]} limit switch at "
@@ -524,30 +528,57 @@ class Machine:
     # ---------------------------------------------------------------- fast-forward
     def _loop_anchor(self, anchor: tuple, own: int | None, remaining: float) -> None:
         """A loop came round: report a busy loop, skip identical passes (fastforward.py)."""
-        visit = Visit(self._state_key(own), self.wake, self.effects, self.inputs.version,
-                      self.waits)
-        previous = self.anchors.arrive(anchor, visit)
-        if previous is None:
+        previous = self.anchors.visits.get(anchor)
+        key = self._state_key(own)
+        if previous is not None:
+            self._busy_loop(anchor, key, previous, remaining)
+        visit = self._visit(key, previous)
+        self.anchors.arrive(anchor, visit)
+        if previous is None or self.fast_forward == "off" or not same_pass(previous, visit):
             return
-        looped = anchor[0] == "rp" or (visit.key is not None and visit.key == previous.key)
-        if looped and visit.waits == previous.waits and remaining >= BUSY_PASSES:
-            self._hazard("busy-loop", f"{self.chunk.label} loops without a wait: it runs at "
-                         f"the full command rate; add WA", where=self._where_anchor(anchor))
-            return
-        if not same_pass(previous, visit):
+        if visit.shape and self.fast_forward != "all":
             return
         passes = skippable(previous, visit, min(self._horizon, self._next_hardware()), remaining)
         if passes > 0:
-            self._skip(anchor, own, passes, visit.wake - previous.wake)
+            self._skip(anchor, own, passes, visit.wake - previous.wake, visit)
 
-    def _skip(self, anchor: tuple, own: int | None, passes: int, period: int) -> None:
+    def _busy_loop(self, anchor: tuple, key: tuple | None, previous: Visit,
+                   remaining: float) -> None:
+        """Report a long loop without waits, once; it ends the pass, so that pass is not
+        skipped (a loop is skipped after two passes without a new hazard, as plain
+        stepping would report none in the passes skipped)."""
+        looped = anchor[0] == "rp" or (key is not None and key == previous.key)
+        if looped and self.waits == previous.waits and remaining >= BUSY_PASSES:
+            self._hazard("busy-loop", f"{self.chunk.label} loops without a wait: it runs at "
+                         f"the full command rate; add WA", where=self._where_anchor(anchor))
+
+    def _visit(self, key: tuple | None, previous: Visit | None) -> Visit:
+        """This arrival at an anchor, with what the pass since `previous` emitted."""
+        if len(self._log) > LOG_LIMIT:  # passes this long are not compared
+            self._log_base += len(self._log)
+            self._log.clear()
+        pass_shape = None
+        if (previous is not None and key is not None and key == previous.key
+                and previous.logged >= self._log_base):
+            pass_shape = ff.shape(self._log[previous.logged - self._log_base:], previous.wake)
+        return Visit(key, self.wake, self.inputs.version, self.waits,
+                     self._log_base + len(self._log), pass_shape)
+
+    def _skip(self, anchor: tuple, own: int | None, passes: int, period: int,
+              visit: Visit) -> None:
+        """Skip `passes` copies of the pass that ended at `visit`; the clock jumps exactly."""
         start = self.wake
         self.wake += passes * period
         if own is not None:
             self.counters[self.chunk.slot][own] -= passes
-        self.anchors.arrive(anchor, Visit(self._state_key(own), self.wake, self.effects,
-                                          self.inputs.version, self.waits))
-        self._emit(ev.FastForwarded(start, self.wake, passes, period, self._where_anchor(anchor)))
+        if self.on_report is not None:  # the host hears every report (mercmac emulate)
+            for r in ff.expand(visit.shape, start, period, passes, ff.REPORT):
+                self.on_report(r.t / 1000, r.text)
+        self._emit(ev.FastForwarded(start, self.wake, passes, period,
+                                    self._where_anchor(anchor), visit.shape))
+        # after the skip's own event: it belongs to enclosing loops, not to the next pass
+        self.anchors.arrive(anchor, Visit(visit.key, self.wake, self.inputs.version, self.waits,
+                                          self._log_base + len(self._log), visit.shape))
 
     def _state_key(self, own: int | None) -> tuple | None:
         """The whole machine state except the clock and the jumping RP's own counter."""
@@ -598,9 +629,10 @@ class Machine:
         where = self._where(self.ip - 1) if where == "here" else where
         place = (where.slot, where.ip) if where else None
         if self.hazards.first(rule, place):
-            self.effects += 1
             self._emit(ev.HazardFound(self.clock.now, rule, message, where))
 
     def _emit(self, event: object) -> None:
+        if ff.logged(event):
+            self._log.append(event)
         if self.on_event is not None:
             self.on_event(event)

@@ -4,7 +4,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from mercmac.commands import C663, C863, MAX_INT32, MODELS
-from mercmac.errors import UsageError
+
+
+class ModelError(ValueError):
+    """A controller model the simulator does not know."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -46,10 +49,10 @@ class Options:
 
 
 def model_name(name: str | None) -> str:
-    """'c-663' -> 'C-663'; None -> C-863 (SPEC §3 default); anything else is a usage error."""
+    """'c-663' -> 'C-663'; None -> C-863 (SPEC §3 default); anything else is a ModelError."""
     if name is None:
         return C863
     upper = name.upper()
     if upper not in MODELS:
-        raise UsageError(f"unknown controller model '{name}': use {' or '.join(MODELS)}")
+        raise ModelError(f"unknown controller model '{name}': use {' or '.join(MODELS)}")
     return upper

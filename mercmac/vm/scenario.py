@@ -16,13 +16,22 @@ The first expectation that fails ends the run with its reason (exit 1).
 """
 from __future__ import annotations
 
+import codecs
+import json
+import os
+import stat
 from dataclasses import dataclass
 
-from mercmac.errors import MercmacError, UsageError
+from mercmac.errors import MercmacError
 from mercmac.timespec import TimeSpecError, parse_duration
 from mercmac.vm.machine import Machine
 
 CHECKS = ("outputs", "position", "macro", "running")
+MAX_BYTES = 1_000_000  # far above any hand-written scenario; keeps /dev/zero-like files out
+
+
+class ScenarioError(ValueError):
+    """A scenario file that cannot be read or says something impossible; the message says where."""
 
 
 class ScenarioFailed(MercmacError):
@@ -58,75 +67,164 @@ class Scenario:
 
 
 def load(path: str) -> Scenario:
-    """Read and validate a scenario file; any problem is a usage error naming the place."""
+    """Read and validate a scenario file; ScenarioError names the file and the place."""
     try:
         import tomllib
     except ModuleNotFoundError:  # Python 3.10
         import tomli as tomllib
+    text = _decode(path, _read(path))
     try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise UsageError(f"{path}: not valid TOML: {e}") from None
+        raise ScenarioError(f"{path}: not valid TOML: {e}") from None
+    except ValueError:  # int() refuses numbers of more than 4300 digits
+        raise ScenarioError(f"{path}: not valid TOML: a number has far too many digits") from None
+    except RecursionError:  # tomllib nests one call per [ or {
+        raise ScenarioError(f"{path}: not valid TOML: arrays or tables nested too deeply") from None
+    return parse(path, data)
+
+
+def _read(path: str) -> bytes:
+    """The file's bytes; OSError (no such file, ...) is left to the CLI, which names the file."""
+    if not stat.S_ISREG(os.stat(path).st_mode):  # reading a FIFO or /dev/zero never ends
+        raise ScenarioError(f"{path}: not a regular file")
+    with open(path, "rb") as f:
+        raw = f.read(MAX_BYTES + 1)
+    if len(raw) > MAX_BYTES:
+        raise ScenarioError(f"{path}: larger than {MAX_BYTES // 1_000_000} MB; "
+                            "a scenario is a short list of steps and expectations")
+    return raw
+
+
+def _decode(path: str, raw: bytes) -> str:
+    """TOML is UTF-8 (a BOM is allowed); UTF-16 with a BOM, as some Windows editors save, too."""
+    utf16 = raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE))
+    try:
+        return raw.decode("utf-16" if utf16 else "utf-8-sig")
+    except UnicodeDecodeError as e:
+        what = "UTF-16 text, though it starts with a UTF-16 byte order mark" if utf16 else "UTF-8"
+        raise ScenarioError(f"{path}: not {what} (byte {e.start}): "
+                            "save the scenario as UTF-8 TOML") from None
+
+
+def parse(path: str, data: dict) -> Scenario:
+    """Check the tables read from a scenario file; ScenarioError says which key and why."""
     try:
         return _parse(path, data)
-    except (TimeSpecError, TypeError, ValueError) as e:
-        raise UsageError(f"{path}: {e}") from None
+    except ScenarioError as e:
+        raise ScenarioError(f"{path}: {e}") from None
 
 
 def _parse(path: str, data: dict) -> Scenario:
     unknown = set(data) - {"until", "step", "expect"}
     if unknown:
-        raise ValueError(f"unknown key(s) {', '.join(sorted(unknown))}: use until, [[step]], [[expect]]")
-    until = parse_duration(str(data["until"])) if "until" in data else None
-    steps = [_step(i, s) for i, s in enumerate(data.get("step", []), 1)]
-    expects = [_expect(i, e) for i, e in enumerate(data.get("expect", []), 1)]
+        raise ScenarioError(f"unknown key(s) {', '.join(sorted(map(str, unknown)))}: "
+                            "use until, [[step]], [[expect]]")
+    until = _duration("until", data["until"]) if "until" in data else None
+    steps = [_step(i, s) for i, s in enumerate(_tables("step", data), 1)]
+    expects = [_expect(i, e) for i, e in enumerate(_tables("expect", data), 1)]
     return Scenario(path, until, sorted(steps, key=lambda s: s.at_ms), expects)
 
 
-def _inputs(where: str, value) -> tuple[int, ...]:
+def _tables(key: str, data: dict) -> list[dict]:
+    """The [[key]] tables; anything else in their place is refused with what to write."""
+    value = data.get(key, [])
+    if isinstance(value, dict):
+        raise ScenarioError(f"[{key}] is a single table: write [[{key}]] (double brackets), "
+                            f"one per {key}")
+    if not isinstance(value, list):
+        raise ScenarioError(f"{key} = {_show(value)}: write [[{key}]] tables, one per {key}")
+    for i, table in enumerate(value, 1):
+        if not isinstance(table, dict):
+            raise ScenarioError(f"{key} {i} is {_kind(table)} ({_show(table)}), expected a table: "
+                                f"write [[{key}]] with its keys below")
+    return value
+
+
+def _duration(name: str, value) -> int:
+    """Milliseconds from a TOML string such as "1.5s" or a whole number of ms."""
+    if isinstance(value, bool) or not isinstance(value, (str, int)):
+        raise ScenarioError(f"{name} is {_kind(value)} ({_show(value)}), expected a duration "
+                            'such as "250ms" or "1.5s", or a whole number of ms')
+    try:
+        return parse_duration(str(value))
+    except TimeSpecError as e:
+        raise ScenarioError(f"{name}: {e}") from None
+
+
+def _whole(value) -> bool:
+    """A TOML integer (bool is an int in Python, but `true` is not a number)."""
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _inputs(name: str, value) -> tuple[int, ...]:
     values = value if isinstance(value, list) else [value]
-    if not all(isinstance(v, int) and 1 <= v <= 6 for v in values):
-        raise ValueError(f"{where}: inputs are numbers 1-6")
+    if not all(_whole(v) and 1 <= v <= 6 for v in values):
+        raise ScenarioError(f"{name} = {_show(value)}: inputs are numbers 1-6, alone or in a list "
+                            "such as [1, 3] (1-4 buttons, 5 joystick, 6 joystick button)")
     return tuple(values)
 
 
 def _step(i: int, raw: dict) -> Step:
-    if "at" not in raw or not set(raw) <= {"at", "press", "release"}:
-        raise ValueError(f"step {i}: write at = \"1s\" with press = [..] and/or release = [..]")
-    return Step(parse_duration(str(raw["at"])), _inputs(f"step {i}", raw.get("press", [])),
-                _inputs(f"step {i}", raw.get("release", [])))
+    unknown = set(raw) - {"at", "press", "release"}
+    if "at" not in raw or unknown:
+        extra = f" (unknown: {', '.join(sorted(unknown))})" if unknown else ""
+        raise ScenarioError(f"step {i}: write at = \"1s\" with press = [..] and/or "
+                            f"release = [..]{extra}")
+    return Step(_duration(f"step {i}: at", raw["at"]),
+                _inputs(f"step {i}: press", raw.get("press", [])),
+                _inputs(f"step {i}: release", raw.get("release", [])))
 
 
 def _expect(i: int, raw: dict) -> Expect:
     checks = {k: v for k, v in raw.items() if k in CHECKS}
     timing = set(raw) - set(checks)
     if not checks or timing not in ({"at"}, {"within"}):
-        raise ValueError(f"expect {i}: give `at` or `within` and one or more of {', '.join(CHECKS)}")
+        raise ScenarioError(f"expect {i}: give `at` or `within` and one or more of "
+                            f"{', '.join(CHECKS)}")
     if "at" in raw:
-        start = end = parse_duration(str(raw["at"]))
+        start = end = _duration(f"expect {i}: at", raw["at"])
     else:
         window = raw["within"]
         if not (isinstance(window, list) and len(window) == 2):
-            raise ValueError(f"expect {i}: within = [\"T1\", \"T2\"]")
-        start, end = (parse_duration(str(t)) for t in window)
+            raise ScenarioError(f"expect {i}: within = {_show(window)}: "
+                                'expected two times, within = ["T1", "T2"]')
+        start, end = (_duration(f"expect {i}: within", t) for t in window)
         if end < start:
-            raise ValueError(f"expect {i}: the window ends before it starts")
+            raise ScenarioError(f"expect {i}: the window ends before it starts")
     for key, value in checks.items():
         _validate(i, key, value)
     return Expect(i, start, end, checks)
 
 
+EXPECTED = {  # what each check takes, and how to say so
+    "outputs": (lambda v: _whole(v) and 0 <= v <= 15, "the LED pattern, a whole number 0-15"),
+    "position": (lambda v: _whole(v) or (isinstance(v, list) and len(v) == 2
+                                         and all(map(_whole, v)) and v[0] <= v[1]),
+                 "a whole number, or a range [low, high] with low <= high"),
+    "macro": (lambda v: v == "none" or (_whole(v) and 0 <= v <= 31),
+              'a macro number 0-31, or "none" for direct mode'),
+    "running": (lambda v: isinstance(v, bool), "true or false"),
+}
+
+
 def _validate(i: int, key: str, value) -> None:
-    ok = {
-        "outputs": lambda v: isinstance(v, int) and 0 <= v <= 15,
-        "position": lambda v: isinstance(v, int) or (isinstance(v, list) and len(v) == 2
-                                                     and all(isinstance(x, int) for x in v)),
-        "macro": lambda v: v == "none" or (isinstance(v, int) and 0 <= v <= 31),
-        "running": lambda v: isinstance(v, bool),
-    }[key](value)
-    if not ok:
-        raise ValueError(f"expect {i}: bad {key} = {value!r}")
+    ok, expected = EXPECTED[key]
+    if not ok(value):
+        raise ScenarioError(f"expect {i}: {key} = {_show(value)}: expected {expected}")
+
+
+def _kind(value) -> str:
+    """The TOML name of a value's type, for messages."""
+    kinds = ((bool, "a boolean"), (int, "an integer"), (float, "a float"), (str, "a string"),
+             (list, "an array"), (dict, "a table"))
+    return next((name for t, name in kinds if isinstance(value, t)), "a date or time")
+
+
+def _show(value, limit: int = 40) -> str:
+    """A value as TOML would write it, shortened for a message."""
+    text = json.dumps(value, default=str, ensure_ascii=True)
+    return text if len(text) <= limit else f"{text[:limit - 12]}...{text[-9:]}"
 
 
 def mismatch(m: Machine, checks: dict) -> str | None:

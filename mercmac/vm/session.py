@@ -4,7 +4,9 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass
 
+from mercmac.commands import MAX_INT32
 from mercmac.errors import UsageError
+from mercmac.outfile import replacing, writable_target
 from mercmac.timespec import TimeSpecError, parse_buttons, parse_duration
 from mercmac.vm.models import Options
 from mercmac.vm.simulate import DEFAULT_UNTIL_MS, Run, machine_for, schedule, simulate
@@ -20,6 +22,7 @@ class Request:
     fmt: str = "text"
     trace: bool = False
     vcd: str | None = None
+    vcd_limit_mb: float = 100  # 0: no limit
     interactive: bool = False
     speed: float = 1.0
     scenario: str | None = None
@@ -32,7 +35,22 @@ class Request:
 
 def run(req: Request) -> bool:
     """Carry out a request; False when the file has errors or a scenario fails."""
+    from mercmac.vm.clock import CycleError
+    from mercmac.vm.models import ModelError
+    from mercmac.vm.scenario import ScenarioError
+
+    try:
+        return _run(req)
+    except CycleError as e:  # the core's own errors are bad options here (exit 2)
+        raise UsageError(f"--cycle: {e}") from None
+    except (ModelError, ScenarioError) as e:
+        raise UsageError(str(e)) from None
+
+
+def _run(req: Request) -> bool:
     presses = _presses(req.buttons)
+    if req.vcd:  # a path that cannot be written is refused before any work (exit 2)
+        writable_target(req.vcd)
     options = Options(servo_on=not req.servo_off, reference_at=req.reference_at,
                       hard_limits=_limits(req.hard_limits))
     program = _compile(req)
@@ -57,12 +75,16 @@ def run(req: Request) -> bool:
 def _simulate(req: Request, program, presses, until: int, common: dict) -> Run:
     if not req.vcd:
         return simulate(program, presses=presses, until_ms=until, trace=req.trace, **common)
-    try:
-        with open(req.vcd, "w", encoding="ascii") as vcd:
-            return simulate(program, presses=presses, until_ms=until, trace=req.trace,
-                            vcd=vcd, **common)
-    except OSError as e:
-        raise UsageError(f"cannot write {req.vcd}: {e.strerror or e}") from None
+    # the old file stays until the new one is complete; Ctrl-C or an error leaves no temp
+    limit = round(req.vcd_limit_mb * 1_000_000) if req.vcd_limit_mb else None
+    with replacing(req.vcd, encoding="ascii") as vcd:
+        result = simulate(program, presses=presses, until_ms=until, trace=req.trace,
+                          vcd=vcd, vcd_limit=limit, **common)
+    if result.vcd_cut_at is not None:
+        from mercmac.render import sim as render
+
+        render.write_vcd_cut(req.vcd, req.vcd_limit_mb, result.vcd_cut_at, sys.stderr)
+    return result
 
 
 def _scenario(req: Request, program, presses, common: dict) -> bool:
@@ -131,4 +153,6 @@ def _limits(text: str | None) -> tuple[int, int] | None:
         raise UsageError(f"--hard-limits '{text}': write NEG,POS, e.g. -200000,200000") from None
     if not low < high:
         raise UsageError(f"--hard-limits '{text}': the negative limit must be below the positive one")
+    if not -MAX_INT32 <= low < high <= MAX_INT32:  # positions are 32-bit on the controller
+        raise UsageError(f"--hard-limits: positions are {-MAX_INT32} to {MAX_INT32}")
     return low, high

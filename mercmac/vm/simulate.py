@@ -20,6 +20,7 @@ class Run:
     machine: Machine
     record: Recorder
     until_ms: int
+    vcd_cut_at: int | None = None  # us: where the VCD stopped at its size limit
 
     @property
     def halted(self) -> bool:
@@ -42,29 +43,39 @@ def schedule(machine: Machine, presses: Iterable[Press]) -> None:
 
 
 def machine_for(program: Program, *, model: str | None = None, cycle_ms: float = 1.0,
-                options: Options | None = None, trace: bool = False) -> tuple[Machine, Recorder]:
-    """A machine with a recorder attached, not yet powered on."""
+                options: Options | None = None, trace: bool = False,
+                fast_forward: str = "all") -> tuple[Machine, Recorder]:
+    """A machine with a recorder attached, not yet powered on.
+
+    The recorder counts what skipped passes emitted, so every repeating pass may
+    be skipped (fast_forward "all"); "off" steps every pass (for comparisons).
+    """
     record = Recorder()
     machine = Machine(program, model=model, cycle_ms=cycle_ms, options=options,
-                      on_event=record.on_event, trace=trace)
+                      on_event=record.on_event, trace=trace, fast_forward=fast_forward)
     return machine, record
 
 
 def simulate(program: Program, *, presses: Iterable[Press] = (), until_ms: int = DEFAULT_UNTIL_MS,
              model: str | None = None, cycle_ms: float = 1.0, options: Options | None = None,
-             trace: bool = False, vcd: IO[str] | None = None) -> Run:
-    """Power on at t = 0 (macro 0 starts, SPEC §3 Power-on) and run to until_ms."""
+             trace: bool = False, vcd: IO[str] | None = None,
+             vcd_limit: int | None = None) -> Run:
+    """Power on at t = 0 (macro 0 starts, SPEC §3 Power-on) and run to until_ms.
+
+    A VCD stops (a valid file) before it would pass `vcd_limit` bytes; the run goes on.
+    """
     machine, record = machine_for(program, model=model, cycle_ms=cycle_ms, options=options,
                                   trace=trace)
     dump = None
     if vcd is not None:
         from mercmac.vm.vcd import VcdObserver
 
-        dump = VcdObserver(vcd, record.on_event)
+        dump = VcdObserver(vcd, record.on_event, vcd_limit)
         machine.on_event = dump.on_event
     schedule(machine, presses)
     machine.power_on()
     machine.run_until(until_ms)
-    if dump is not None:
-        dump.close(round(until_ms * 1000))
-    return Run(machine, record, until_ms)
+    if dump is None:
+        return Run(machine, record, until_ms)
+    dump.close(round(until_ms * 1000))
+    return Run(machine, record, until_ms, dump.cut_at)

@@ -1,8 +1,11 @@
 """A Value Change Dump of a run for GTKWave or Surfer, written with pyvcd (issue 3, `--vcd`).
 
-The writer listens to the machine's events as they happen, so nothing is
-capped: inputs, outputs, the running macro, and the position sampled every
-millisecond while a profile runs (exact at its ends).
+The writer listens to the machine's events as they happen: inputs, outputs,
+the running macro, and the position sampled every millisecond while a profile
+runs (exact at its ends). A fast-forwarded stretch is written compactly: the
+wire `vm.fast_forward` is 1 while its passes are left out, and the last pass is
+dumped in full (issue 7: a day of blinking is not a million value changes).
+The dump stops cleanly before it would pass `limit` bytes; `cut_at` says when.
 """
 from __future__ import annotations
 
@@ -11,33 +14,65 @@ from typing import IO
 from vcd import VCDWriter
 
 from mercmac.vm import events as ev
+from mercmac.vm import fastforward as ff
 
 SAMPLE_US = 1000  # position samples while moving
+CLOSING = 65_536  # bytes kept in hand below the limit: far more than one event writes
+
+
+class _Counted:
+    """A text stream that counts the characters written (ASCII: bytes)."""
+
+    def __init__(self, stream: IO[str]):
+        self.stream, self.written = stream, 0
+
+    def write(self, text: str) -> int:
+        self.written += len(text)
+        return self.stream.write(text)
+
+    def flush(self) -> None:
+        self.stream.flush()
 
 
 class VcdObserver:
     """An event listener that writes value changes; call `close(t_us)` at the end."""
 
-    def __init__(self, stream: IO[str], then=None):
+    def __init__(self, stream: IO[str], then=None, limit: int | None = None):
         self.then = then  # the next listener (the recorder)
-        self.writer = VCDWriter(stream, timescale="1 us", date="", comment="mercmac sim")
+        self.out = _Counted(stream)
+        self.limit = limit
+        self.cut_at: int | None = None  # us: where the dump stopped at the size limit
+        self.writer = VCDWriter(self.out, timescale="1 us", date="", comment="mercmac sim")
         reg = self.writer.register_var
         self.inputs = [None] + [reg("box", f"in{n}", "wire", size=1, init=0) for n in range(1, 7)]
         self.outputs = [reg("box", f"out{n}", "wire", size=1, init=0) for n in range(1, 5)]
         self.position = reg("axis", "position", "integer", size=32, init=0)
         self.target = reg("axis", "target", "integer", size=32, init=0)
         self.macro = reg("vm", "macro", "reg", size=6, init="z")
+        self.skipping = reg("vm", "fast_forward", "wire", size=1, init=0)
         self.segments: tuple = ()
         self.sampled_to = 0
         self.last = 0
 
     def on_event(self, event) -> None:
-        t = max(getattr(event, "t", self.last), self.last)
-        self._sample(t)
-        self.last = t
-        self._change(event, t)
+        if self.cut_at is None:
+            t = max(getattr(event, "t", self.last), self.last)
+            self._sample(t)
+            self.last = t
+            if self.cut_at is None:
+                self._change(event, t)
+                self._check_size(self.last)
         if self.then:
             self.then(event)
+
+    def _full(self) -> bool:
+        return self.limit is not None and self.out.written + CLOSING > self.limit
+
+    def _check_size(self, t: int) -> None:
+        """Stop the dump at t, a valid file, before it passes the limit."""
+        if self._full():
+            self.cut_at = t
+            self.writer.close(t)
 
     def _change(self, event, t: int) -> None:
         w = self.writer
@@ -57,6 +92,23 @@ class VcdObserver:
             case ev.MoveEnded(_, _, position) | ev.HomeDefined(_, position):
                 self.segments = ()
                 w.change(self.position, t, position)
+            case ev.FastForwarded(_, _, passes, period, _, shape):
+                self._stretch(t, passes, period, shape)
+
+    def _stretch(self, t: int, passes: int, period: int, shape: tuple) -> None:
+        """Skipped passes: marked, all but the last left out; the last one dumped."""
+        last = t + (passes - 1) * period
+        if passes > 1:
+            self.writer.change(self.skipping, t, 1)
+            self.writer.change(self.skipping, last, 0)
+        self.last = last
+        for item in shape:
+            if item[0] == ff.OUTPUTS:
+                self.last = last + item[1]
+                for i, var in enumerate(self.outputs):
+                    self.writer.change(var, self.last, item[2] >> i & 1)
+            elif item[0] == ff.SKIP:
+                self._stretch(last + item[1], item[2], item[3], item[4])
 
     def _sample(self, until: int) -> None:
         """Position samples of the running profile up to `until`."""
@@ -65,13 +117,18 @@ class VcdObserver:
         end = min(until, int(self.segments[-1].t1) + 1)
         t = self.sampled_to
         while t < end:
+            if self._full():
+                self._check_size(t)
+                return
             self.writer.change(self.position, t, round(_position(self.segments, t)))
             t += SAMPLE_US
         self.sampled_to = t
 
     def close(self, t_us: int) -> None:
-        self._sample(t_us)
-        self.writer.close(t_us)
+        if self.cut_at is None:
+            self._sample(t_us)
+        if self.cut_at is None:
+            self.writer.close(t_us)
 
 
 def _position(segments: tuple, t: float) -> float:
