@@ -64,12 +64,20 @@ lowers to RP N-1) and `every T` 0-65535 ms (it lowers to WA T)."""),
     Rule("MM005", "too-many-commands", _E, "a macro holds more than 16 base commands", """\
 A stored macro holds at most 16 base commands (MS176E §3.8, §3.8.4). The
 controller would cut or refuse a longer line. mercmac fits a long high-level
-block when that keeps the meaning: a straight line is chained into parts
-reached by a tail EM; a loop (RP repeats the whole line, so a chain would
-repeat only its last part) keeps its line and moves runs of plain commands
-into macros it calls. Calls, XN/XF conditions and TI cannot move, and a raw
-`[MCnn]` block is kept exactly as written. Move part of the work into a macro
-of its own and call it, or shorten the block."""),
+block when that keeps the meaning:
+  - a straight line is chained into parts reached by a tail EM;
+  - a loop (RP repeats the whole line, so a chain would repeat only its last
+    part) keeps its line and moves runs of plain commands into macros it
+    calls; what follows its last RP is chained;
+  - a loop that starts its macro stays in the line (RP jumps to the start),
+    so `repeat 3 { MR 10, TT }, CN 2` is `MR10,TT,RP2,CN2`, one macro;
+  - a small repeat of plain commands in a block that must call nothing (a
+    when inside a loop) is written out: `MR100,MR100,MR100`;
+  - `repeat 40000` is `RP1,RP19999` (2 x 20000 passes), `every 2min` waits
+    with `WA60000,WA60000`, `repeat 0` is left out.
+Calls, XN/XF conditions and TI cannot move, and a raw `[MCnn]` block is kept
+exactly as written. Move part of the work into a macro of its own and call it,
+or shorten the block."""),
     Rule("MM006", "slot-range", _E, "macro number outside 0-31, or more than 32 macros", """\
 Macros are numbered 0 to 31 (MS176E §3.8.4); macro 0 is the autostart macro.
 A raw block or a pin (`macro NAME @n`) outside 0-31 cannot be stored, and a
@@ -104,9 +112,17 @@ remainder of MC1". When macro A continues after `EMb` and b contains an EM,
 b's EM replaces A's return point and the rest of A never runs; Example 3's
 MC18 can no longer return to its own caller. On raw blocks this is a warning
 (it is the manual's way of switching modes, Example 4); on `call` it is an
-error. Use `goto` for a transfer that is not meant to return, make the callee
-call nothing, or restructure so that the rest follows in a macro reached by a
-tail EM."""),
+error, and so is a `call` of a macro that ends in (or may run) a `goto`: it
+never comes back. Use `goto` for a transfer that is not meant to return, make
+the callee call nothing, or restructure. mercmac does this for you where the
+meaning stays the same:
+  - a hoisted `when`/`repeat` block that calls, or is too long for one macro,
+    ends in a tail EM to a macro holding the rest of its caller;
+  - a loop that starts its macro stays in the line, so the macro stays a leaf
+    that may be called with code after the call;
+  - a called macro that calls on (and holds no goto) is inlined into a caller
+    that continues after the call;
+  - a small repeat inside a `when` inside a loop is written out in place."""),
     Rule("MM012", "undefined-macro", _W, "EM to a slot no block defines", """\
 "If there is no macro defined for the number n, no action will be taken"
 (MS176E §6.4 EM). Example 1's MC13 calls 14-17 without defining them. Define
@@ -143,6 +159,26 @@ Each `const` name may be defined once, so that every use of the name means
 one value wherever it stands (a second definition would silently change the
 numbers sent to the controller above or below it). Rename one of them, or
 remove the duplicate."""),
+)
+
+RULES += (
+    Rule("MM030", "goto-ends-loop", _W, "a repeat or every block ends in a goto: it runs once", """\
+A goto transfers for good (SPEC §1), so a loop whose block ends in one leaves
+on its first pass: `repeat 3 { CN 1, TT, goto x }` means `CN 1, TT, goto x`,
+and mercmac lowers it so (`CN1,TT,EMx`). Code after such a loop never runs.
+Drop the loop, or put the goto in a `when` block so that it only leaves the
+loop when an input says so."""),
+    Rule("MM031", "ti-moved", _W, "a TI runs in another macro than the RP of its loop", """\
+TI reports the remaining count of the RP in the running macro, and each macro
+has its own RP counters that reset when it is entered (MS176E §6.4 RP, TI;
+SPEC §3). A TI in a `when` block inside a loop runs in the macro the block is
+hoisted into, so it reports that macro's counter (0) instead of the loop's:
+`repeat 3 { when 1 { TI } }` reports 0, 0, 0 where the loop means 0, 2, 1.
+Move the TI out of the when block, straight into the loop."""),
+    Rule("MM032", "repeat-zero", _I, "repeat 0: the block never runs", """\
+`repeat 0 { ... }` runs its block no times, so mercmac leaves it out (RP
+cannot express it: a line always runs at least once, MS176E §6.4 RP). Remove
+the block, or give a count of 1 or more."""),
 )
 
 _BY_KEY = {r.code: r for r in RULES} | {r.name: r for r in RULES}

@@ -10,6 +10,7 @@ from mercmac.compiler import ast
 from mercmac.compiler.checks import Env
 
 CONTROL = {"EM", "XN", "XF", "RP"}
+CUT = "..."  # ends a trace cut short by its step budget (long loops without effects)
 
 
 class Budget(Exception):
@@ -23,9 +24,11 @@ class _Goto(Exception):
         self.name = name
 
 
-def high_level_trace(module: ast.Module, env: Env, inputs: set[int], limit: int = 200) -> list[str]:
+def high_level_trace(module: ast.Module, env: Env, inputs: set[int], limit: int = 200,
+                     steps: int = 200_000) -> list[str]:
     """What the autostart block means, run with inputs held as given."""
     trace: list[str] = []
+    budget = [steps]
     macros = {m.name: m for m in module.items if isinstance(m, ast.MacroDef)}
     start = next(i for i in module.items if isinstance(i, ast.Autostart))
 
@@ -34,8 +37,15 @@ def high_level_trace(module: ast.Module, env: Env, inputs: set[int], limit: int 
         if len(trace) >= limit:
             raise Budget
 
+    def tick():
+        budget[0] -= 1
+        if budget[0] < 0:
+            trace.append(CUT)
+            raise Budget
+
     def run(body):
         for stmt in body:
+            tick()
             if isinstance(stmt, ast.Command):
                 op = env.ops[stmt]
                 if op.mnemonic in CONTROL:
@@ -51,13 +61,15 @@ def high_level_trace(module: ast.Module, env: Env, inputs: set[int], limit: int 
             elif isinstance(stmt, ast.Repeat):
                 for _ in range(env.values[stmt.count]):
                     run(stmt.body)
+                    tick()
             elif isinstance(stmt, ast.Every):
                 for _ in range(2**32):
                     run(stmt.body)
                     emit(f"WA{env.values[stmt.period]}")
+                    tick()
 
     body = start.body
-    for _ in range(10_000):  # a goto cycle without effects runs until the budget
+    while True:  # a goto cycle without effects runs until the step budget
         try:
             run(body)
             break
@@ -65,6 +77,10 @@ def high_level_trace(module: ast.Module, env: Env, inputs: set[int], limit: int 
             break
         except _Goto as g:
             body = macros[g.name].body
+            try:
+                tick()
+            except Budget:
+                break
     return trace
 
 
@@ -108,4 +124,26 @@ def firmware_trace(lines: dict[int, list[tuple[str, int | None]]], inputs: set[i
             if len(trace) >= limit:
                 return trace
         pc += 1
-    return trace
+    return trace + [CUT]
+
+
+def _merged(trace: list[str]) -> list[str]:
+    """Consecutive waits as one (`WA60000,WA60000` is `WA120000`), `WA0` dropped: time-free."""
+    out: list[str] = []
+    for text in trace:
+        if text.startswith("WA") and text[2:].isdigit():
+            ms = int(text[2:]) + (int(out.pop()[2:]) if out and out[-1].startswith("WA") else 0)
+            if ms:
+                out.append(f"WA{ms}")
+        else:
+            out.append(text)
+    return out
+
+
+def same_effects(got: list[str], want: list[str], limit: int = 200) -> bool:
+    """Whether two traces mean the same; a trace cut at `limit` is compared as a prefix."""
+    a, b = _merged([t for t in got if t != CUT]), _merged([t for t in want if t != CUT])
+    if len(got) < limit and len(want) < limit and CUT not in got + want:
+        return a == b
+    n = min(len(a), len(b)) - 1  # the last entry of a cut trace may be a partial wait
+    return a[:max(n, 0)] == b[:max(n, 0)]

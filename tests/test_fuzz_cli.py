@@ -187,3 +187,23 @@ def test_scenarios_never_trace(until, steps, raw):
 ])
 def test_odd_arguments_never_trace(args):
     invoke(args)
+
+
+@BUDGET
+@given(command=st.sampled_from(["flash", "pull", "scan"]), timeout=NUMBER, baud=NUMBER,
+       address=NUMBER, port=st.sampled_from(["/nonexistent/ttyUSB9", "socket://127.0.0.1:1",
+                                             "COM3", "", "\x1b[2J", "examples/macros/jog-box.mcm"]),
+       backup=st.sampled_from([None, "/dev/null", "/", "/nonexistent/dir/b.mcm"]))
+def test_uploader_options_never_trace(command, timeout, baud, address, port, backup):
+    args = [command, port]
+    if command == "flash":
+        args.append(str(EXAMPLES / "jog-box.mcm"))
+    args += ["--timeout", timeout, "--baud", baud]
+    if command != "scan":
+        args += ["--address", address]
+    if backup and command == "flash":
+        args += ["--backup", backup]
+    elif backup and command == "pull":
+        args += ["-o", backup]
+    invoke(args)
+    assert Path("/dev/null").is_char_device()

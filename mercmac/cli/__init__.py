@@ -9,7 +9,7 @@ import click
 
 from mercmac import __version__
 from mercmac.cli.common import MODEL_CHOICE, run_guarded, say
-from mercmac.errors import EXIT_FAILED, EXIT_OK, EXIT_USAGE, UsageError
+from mercmac.errors import EXIT_FAILED, EXIT_OK, EXIT_USAGE
 
 
 class _Commands(click.Group):
@@ -68,7 +68,9 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, limit: int | Non
             try:
                 source = read_source(f)
             except OSError as e:
-                say(f"cannot read {f}: {e.strerror or e}")
+                from mercmac.outfile import reason
+
+                say(f"cannot read {f}: {reason(e)}")
                 unreadable += 1
                 continue
             results.append(_check_one(source, target))

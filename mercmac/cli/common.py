@@ -82,8 +82,10 @@ def _tell(e: BaseException) -> int:
     if isinstance(e, BrokenPipeError):  # `mercmac sim ... | head`: the reader has gone, so stop quietly
         _silence_stdout()
         return EXIT_FAILED
+    from mercmac.outfile import reason
+
     name = f"{e.filename}: " if getattr(e, "filename", None) else ""
-    say(f"{name}{getattr(e, 'strerror', None) or e}")
+    say(f"{name}{reason(e)}")
     return EXIT_USAGE
 
 

@@ -5,14 +5,16 @@ The pass also resolves what lowering needs: each valid native command as an
 """
 from __future__ import annotations
 
+import functools
+
 from mercmac.commands import MODELS, Arg, lookup, nearest
 from mercmac.compiler import ast
-from mercmac.compiler.program import SLOTS, Op
+from mercmac.compiler.program import MAX_WA, MAX_WAITS, SLOTS, Op, rp_counts
 from mercmac.diagnostics import Report
 from mercmac.source import Span
 
 MAX_REPEAT = 32_568 + 1  # `repeat N` lowers to RP N-1; MS176E §6.4 RP: n <= 32568
-MAX_PERIOD_MS = 65_535  # `every T` lowers to WA T; MS176E §6.4 WA
+MAX_PERIOD_MS = MAX_WA * MAX_WAITS  # `every T` lowers to WA T, several WAs past 65535 ms
 INPUTS = range(1, 7)  # XN/XF: 1-4 inputs, 5 joystick, 6 joystick button (§6.4 XN)
 
 
@@ -41,7 +43,9 @@ def check_module(module: ast.Module, report: Report, target: str | None) -> Env:
             _claim_slot(0, item.span, "the autostart macro (macro 0)", slots, report)
             _block(item.body, env, report)
         elif isinstance(item, ast.MacroDef):
-            if item.pin is not None:
+            if isinstance(item.pin, ast.Invalid):
+                _resolve(item.pin, env, report)
+            elif item.pin is not None:
                 _claim_slot(item.pin.value, item.pin.span, f"macro {item.pin.value}", slots, report)
             _block(item.body, env, report)
     return env
@@ -58,7 +62,9 @@ def _declarations(module: ast.Module, report: Report, env: Env) -> None:
         if isinstance(item, ast.Const):
             if item.name in env.consts:
                 report.add("duplicate-name", item.span, f"const '{item.name}' is defined twice")
-            env.consts[item.name] = item.value
+            # an invalid value is reported here once; its uses resolve to None and stay quiet
+            env.consts[item.name] = _resolve(item.value, env, report) if isinstance(
+                item.value, ast.Invalid) else item.value
         elif isinstance(item, ast.MacroDef):
             first = env.macros.get(item.name)
             if first is not None:
@@ -70,7 +76,8 @@ def _declarations(module: ast.Module, report: Report, env: Env) -> None:
 
 def _claim_slot(slot: int, span: Span, what: str, slots: dict[int, Span], report: Report) -> None:
     if slot not in SLOTS:
-        report.add("slot-range", span, f"macro number {slot} is outside 0-31")
+        shown = slot if slot < ast.TOO_BIG else f"of more than {ast.MAX_DIGITS} digits"
+        report.add("slot-range", span, f"macro number {shown} is outside 0-31")
     elif slot in slots:
         report.add("duplicate-slot", span,
                    f"{what} defines slot {slot} again (first at line {slots[slot].line}); "
@@ -94,13 +101,47 @@ def _block(body: tuple, env: Env, report: Report) -> None:
                          "when takes inputs 1-6 (1-4 buttons, 5 joystick, 6 joystick button)")
             _block(stmt.body, env, report)
         elif isinstance(stmt, ast.Repeat):
-            _bounded(stmt.count, env, report, range(1, MAX_REPEAT + 1),
-                     f"repeat takes a count 1-{MAX_REPEAT} (it lowers to RP n-1, RP n <= 32568)")
+            _repeat_count(stmt, env, report)
+            _loop_goto(stmt, "repeat", report)
             _block(stmt.body, env, report)
         elif isinstance(stmt, ast.Every):
             _bounded(stmt.period, env, report, range(0, MAX_PERIOD_MS + 1),
-                     f"every takes a whole period of 0-{MAX_PERIOD_MS} ms (it lowers to WA)")
+                     f"every takes a whole period of 0-{MAX_PERIOD_MS} ms (it lowers to WA, "
+                     f"several WAs of at most {MAX_WA} ms past that)")
+            _loop_goto(stmt, "every", report)
             _block(stmt.body, env, report)
+
+
+def _repeat_count(stmt: ast.Repeat, env: Env, report: Report) -> None:
+    """1-32569 lowers to one RP, a product of two such counts to two; 0 runs nothing."""
+    number = _resolve(stmt.count, env, report)
+    if number == 0:
+        report.add("repeat-zero", stmt.span, "repeat 0 never runs its block: it is left out")
+    elif number is not None and (number < 0 or rp_counts(number) is None):
+        report.add("argument-range", stmt.count.span,
+                   f"{number} is out of range: repeat takes a count 0-{MAX_REPEAT} (it lowers "
+                   f"to RP n-1, RP n <= 32568), or a product of two such counts (two RPs)")
+
+
+def _loop_goto(stmt, kind: str, report: Report) -> None:
+    """A loop whose block always reaches a goto runs once: the goto leaves it on the
+    first pass (a goto that ends a loop inside it counts: that loop runs once too)."""
+    goto = _first_goto(stmt.body)
+    if goto is not None:
+        report.add("goto-ends-loop", goto.span,
+                   f"this goto ends the {kind} block (line {stmt.span.line}) on its first pass: "
+                   "the block runs once. Drop the loop, or put the goto in a when block")
+
+
+def _first_goto(body: tuple):
+    for s in body:
+        if isinstance(s, ast.Goto):
+            return s
+        if isinstance(s, (ast.Repeat, ast.Every)):
+            inner = _first_goto(s.body)
+            if inner is not None:
+                return inner
+    return None
 
 
 def _macro_name(name: str, span: Span, env: Env, report: Report) -> None:
@@ -122,6 +163,9 @@ def _bounded(value: ast.Value, env: Env, report: Report, allowed: range, expects
 
 
 def _resolve(value: ast.Value, env: Env, report: Report) -> int | None:
+    if isinstance(value, ast.Invalid):
+        report.add(value.rule, value.span, value.message)
+        return None
     if isinstance(value, ast.Number):
         env.values[value] = value.value
         return value.value
@@ -181,6 +225,10 @@ def _command_rules(spec, cmd: ast.Command, env: Env, report: Report) -> None:
                    "is connected (MS176E §3.6.1 caution)")
 
 
+# A file may repeat one unknown word thousands of times (issue 7): look each up once.
+_nearest = functools.lru_cache(maxsize=1024)(nearest)
+
+
 def _unknown(cmd: ast.Command, report: Report) -> None:
     """`EMxx` is EM with a placeholder for its argument; `FOO5` is an unknown command."""
     word = cmd.word
@@ -191,6 +239,6 @@ def _unknown(cmd: ast.Command, report: Report) -> None:
         report.add("syntax", Span(s.line, s.column + 2, s.end_line, s.end_column),
                    f"{spec.expects()}, found the placeholder '{word[2:]}'")
         return
-    guess = nearest(word)
+    guess = _nearest(word.upper())
     hint = f"; did you mean {guess}?" if guess else ""
     report.add("unknown-command", cmd.word_span, f"unknown command '{word}'{hint}")

@@ -59,6 +59,8 @@ def _contradictions(m: Macro, report: Report) -> None:
 
 
 def _call(program: Program, caller: Macro, index: int, op: Op, report: Report) -> None:
+    if op.arg is None:
+        return  # its target got no slot: reported as slot-range
     callee = program.macros.get(op.arg)
     if callee is None:
         report.add("undefined-macro", op.span or caller.span,
@@ -66,7 +68,19 @@ def _call(program: Program, caller: Macro, index: int, op: Op, report: Report) -
                    "nothing (unless the macro is already stored on it)")
         return
     remainder = caller.ops[index + 1:]
-    if not remainder or _returns(program, callee, remainder):
+    if not remainder:
+        return
+    chain = _goto_chain(program, callee) if op.role == "call" else None
+    if chain:
+        rest = ",".join(o.text for o in remainder)
+        report.add("nested-call", op.span or caller.span,
+                   f"{caller.label} calls {callee.label} and continues ({rest}), but "
+                   f"{' -> '.join(chain)} transfers for good: the call never comes back, so "
+                   f"the rest of {caller.label} never runs after it. Write `goto` if the "
+                   "caller need not continue, or make the called macro end without a goto",
+                   Severity.ERROR)
+        return
+    if _returns(program, callee, remainder):
         return
     inner = program.macros[next(o.arg for o in callee.ops
                                 if o.mnemonic == "EM" and o.arg in program.macros)]
@@ -113,6 +127,24 @@ def _ends_on_purpose(program: Program, macro: Macro, then: int | None) -> bool:
     return False
 
 
+def _goto_chain(program: Program, callee: Macro) -> list[str] | None:
+    """The path from a called macro to a goto it may run ('g (MC01) -> goto m (MC02)'),
+    through the macros the compiler made of its blocks; None when it has none."""
+    seen, todo = {callee.slot}, [(callee, [callee.label])]
+    while todo:
+        macro, path = todo.pop(0)
+        for o in macro.ops:
+            target = program.macros.get(o.arg) if o.mnemonic == "EM" else None
+            if target is None:
+                continue
+            if o.role == "goto":
+                return path + [f"goto {target.label}"]
+            if o.role in ("hoist", "continue") and target.slot not in seen:
+                seen.add(target.slot)
+                todo.append((target, path + [target.label]))
+    return None
+
+
 def _advice(op: Op, callee: Macro, inner: Macro) -> str:
     if inner.origin == "part":
         return (f". {callee.label} holds more than {MAX_COMMANDS} commands, so it was chained "
@@ -134,7 +166,7 @@ def _reachability(program: Program, report: Report) -> None:
                 seen.add(op.arg)
                 todo.append(op.arg)
     for m in program.macros.values():
-        if m.slot not in seen and m.origin in _USER_ORIGINS:
+        if m.slot not in seen and m.origin in _USER_ORIGINS and m.name not in program.inlined:
             report.add("unreachable-macro", m.span,
                        f"{m.label} is not reached from the autostart macro; it runs only when "
                        "the host starts it")

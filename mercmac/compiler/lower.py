@@ -9,6 +9,11 @@
   both the block and its caller reach by a tail EM.
 - Blocks over 16 commands are chained through a tail EM when no RP needs the
   whole line; slots are allocated around raw blocks and pins.
+- Issue 8: a loop that starts its line stays in it (RP jumps to the line's
+  start); a macro that calls on only through its own blocks is inlined into a
+  call with code after it; small repeats in a block that must call nothing
+  are unrolled; `repeat N` past RP's range is two RPs, long periods several
+  WAs; a loop whose block reaches a goto runs once; an empty macro is `WA0`.
 """
 from __future__ import annotations
 
@@ -16,7 +21,8 @@ from typing import NamedTuple
 
 from mercmac.compiler import ast
 from mercmac.compiler.checks import Env
-from mercmac.compiler.program import MAX_COMMANDS, SLOTS, Macro, Op, Program
+from mercmac.compiler.program import (MAX_COMMANDS, SLOTS, Macro, Op, Program, rp_counts,
+                                      wait_pieces)
 from mercmac.diagnostics import Report
 from mercmac.source import Span
 
@@ -41,7 +47,9 @@ class _Em(NamedTuple):
 
 def _calls_on(ops: list) -> bool:
     """Whether a called block takes its caller's return point and may then end
-    other than through a goto (after an inner call, an XN/XF exit ends the program)."""
+    other than through a goto (after an inner call, an XN/XF exit ends the program).
+    A block chained into parts is read as the one line it stands for."""
+    ops = _unchained(ops)
     calls = [i for i, op in enumerate(ops) if _is_em(op) and op.role != "goto"]
     if not calls:
         return False
@@ -50,15 +58,28 @@ def _calls_on(ops: list) -> bool:
     return exits_after or not ends_in_goto
 
 
+def _unchained(ops: list) -> list:
+    """A line with its chained parts (tail EMs 'continue' to a part) read back as one."""
+    last = ops[-1] if ops else None
+    if isinstance(last, _Em) and last.role == "continue" and last.target.origin == "part":
+        return ops + _unchained(last.target.ops)  # the tail EM stays: it is a call too
+    return ops
+
+
 def _is_em(op) -> bool:
     return isinstance(op, _Em) or (isinstance(op, Op) and op.mnemonic == "EM")
 
 
 class _Lowerer:
-    def __init__(self, env: Env, report: Report):
+    def __init__(self, env: Env, report: Report, inline: frozenset = frozenset()):
         self.env, self.report = env, report
         self.order: list[_Macro] = []
         self.named: dict[str, _Macro] = {}
+        self.inlinable = inline  # named macros whose calls with code after them are inlined
+        self.budget = 4000  # statements that inlining may copy: hostile input stays cheap
+        self.loops: list[_Macro] = []  # the macro of each loop being lowered (for TI)
+        self.warned: set = set()
+        self.inlined: set[str] = set()
 
     def new(self, name: str, origin: str, span: Span, slot: int | None = None) -> _Macro:
         m = _Macro(name, origin, span, slot)
@@ -74,32 +95,54 @@ class _Lowerer:
 
     # -- statements --------------------------------------------------------
     def seq(self, stmts: tuple, owner: _Macro, *, at_start: bool, loop: bool,
-            cont: _Macro | None = None) -> list:
+            cont: _Macro | None = None, leaf: bool = False, nest: bool = True) -> list:
         """The ops of a statement sequence that runs to the end of `owner`'s line
-        (inside a repeat/every body: up to the loop's RP), then tail-EMs `cont`."""
+        (inside a repeat/every body: up to the loop's RP), then tail-EMs `cont`.
+
+        `leaf`: the line is called from a loop and must call nothing, so small
+        repeats are unrolled. `nest`: a loop at the start of the line may stay in
+        it (false in a loop whose TI would then read an inner RP's counter).
+        """
         out: list = []
         for i, stmt in enumerate(stmts):
             rest = stmts[i + 1:]
-            whole = at_start and not out and not rest and not loop
+            first = at_start and not out
+            again = dict(owner=owner, at_start=first, loop=loop, cont=cont, leaf=leaf, nest=nest)
             if isinstance(stmt, ast.Command):
                 if stmt in self.env.ops:
-                    out.append(self.env.ops[stmt])
-            elif isinstance(stmt, (ast.Call, ast.Goto)):
+                    out.append(self.command(self.env.ops[stmt], owner))
+            elif isinstance(stmt, ast.Goto):
                 target = self.named.get(stmt.name)
                 if target is not None:
-                    out.append(_Em(target, stmt.span, "call" if isinstance(stmt, ast.Call) else "goto"))
-            elif isinstance(stmt, ast.Repeat) and self.count(stmt) == 1:
-                return out + self.seq(stmt.body + rest, owner, at_start=at_start and not out,
-                                      loop=loop, cont=cont)
+                    out.append(_Em(target, stmt.span, "goto"))
+                return out  # a goto transfers for good: nothing after it runs
+            elif isinstance(stmt, ast.Call):
+                if (rest or cont is not None or loop) and self.inline(stmt):
+                    # The callee calls on, so a call with code after it would need a
+                    # second return point: its body runs here instead.
+                    return out + self.seq(self.env.macros[stmt.name].body + rest, **again)
+                target = self.named.get(stmt.name)
+                if target is not None:
+                    out.append(_Em(target, stmt.span, "call"))
+            elif isinstance(stmt, ast.Repeat) and self.count(stmt) == 0:
+                continue  # `repeat 0` runs nothing (reported as info)
+            elif isinstance(stmt, (ast.Repeat, ast.Every)) and self.once(stmt):
+                return out + self.seq(stmt.body + rest, **again)
+            elif isinstance(stmt, ast.Repeat) and leaf and not first and self.unrollable(stmt):
+                return out + self.seq(stmt.body * self.count(stmt) + rest, **again)
             elif isinstance(stmt, ast.When) and not rest and not loop and cont is None:
-                return out + self.conditions(stmt) + self.seq(stmt.body, owner, at_start=False, loop=False)
-            elif isinstance(stmt, (ast.Repeat, ast.Every)) and whole:
-                return out + self.loop_ops(stmt, owner) + _tail(cont, stmt.span)
+                return out + self.conditions(stmt) + self.seq(stmt.body, owner, at_start=False,
+                                                              loop=False, leaf=leaf, nest=nest)
+            elif (isinstance(stmt, (ast.Repeat, ast.Every)) and first and nest
+                  and not (loop and _has_ti(stmt.body))):
+                # RP jumps to the start of the line: a loop that starts its line stays in
+                # it, and what follows runs on the same line once the loop is done.
+                out += self.loop_ops(stmt, owner, leaf)
             else:
                 block = self.helper(owner, type(stmt).__name__.lower(), stmt.span)
                 out.append(_Em(block, stmt.span, "hoist"))
                 mark = len(self.order)
-                block.ops = self.block_ops(stmt, block, None)
+                block.ops = self.block_ops(stmt, block, None, loop or leaf)
                 if (rest or cont) and not loop and _calls_on(block.ops):
                     # The block takes the return point: what follows it continues in
                     # a macro that both the block and this line reach by a tail EM.
@@ -107,27 +150,47 @@ class _Lowerer:
                     after = cont
                     if rest:
                         after = self.helper(owner, "rest", rest[0].span)
-                        after.ops = self.seq(rest, after, at_start=True, loop=False, cont=cont)
-                    block.ops = self.block_ops(stmt, block, after)
+                        after.ops = self.seq(rest, after, at_start=True, loop=False, cont=cont,
+                                             leaf=leaf)
+                    block.ops = self.block_ops(stmt, block, after, leaf)
                     return out + _tail(after, stmt.span)
-        if out and isinstance(out[-1], _Em) and out[-1].role == "goto":
-            return out
         return out + _tail(cont, stmts[-1].span if stmts else owner.span)
 
-    def block_ops(self, stmt, block: _Macro, cont: _Macro | None) -> list:
-        """A hoisted when/repeat/every block's ops, ending with a tail EM to `cont`."""
-        if isinstance(stmt, ast.When):
-            return self.conditions(stmt) + self.seq(stmt.body, block, at_start=False, loop=False,
-                                                    cont=cont)
-        return self.loop_ops(stmt, block) + _tail(cont, stmt.span)
+    def command(self, op: Op, owner: _Macro) -> Op:
+        """A native command; a TI moved away from the RP of its loop is reported."""
+        if op.mnemonic == "TI" and self.loops and self.loops[-1] is not owner \
+                and op.span not in self.warned:
+            self.warned.add(op.span)
+            self.report.add("ti-moved", op.span,
+                            f"this TI runs in '{owner.name}', a macro of its own, not in "
+                            f"'{self.loops[-1].name}' with the RP of its loop: it reports "
+                            f"the counter of '{owner.name}' (0), not the loop's remaining "
+                            "count (each macro has its own RP counters)")
+        return op
 
-    def loop_ops(self, stmt, owner: _Macro) -> list:
-        body = self.seq(stmt.body, owner, at_start=False, loop=True)
+    def block_ops(self, stmt, block: _Macro, cont: _Macro | None, leaf: bool) -> list:
+        """A hoisted when/repeat/every block's ops, fitted, ending with a tail EM to `cont`."""
+        if isinstance(stmt, ast.When):
+            block.ops = self.conditions(stmt) + self.seq(stmt.body, block, at_start=False,
+                                                         loop=False, cont=cont, leaf=leaf)
+        else:
+            block.ops = self.loop_ops(stmt, block, leaf) + _tail(cont, stmt.span)
+        self.fit(block)  # a block that is split calls on, like one that calls
+        return block.ops
+
+    def loop_ops(self, stmt, owner: _Macro, leaf: bool) -> list:
+        """A loop that starts `owner`'s line: its body, then RP (every: WA, RP, RP)."""
+        self.loops.append(owner)
+        body = self.seq(stmt.body, owner, at_start=True, loop=True, leaf=leaf,
+                        nest=not _has_ti(stmt.body))
+        self.loops.pop()
         if isinstance(stmt, ast.Repeat):
-            return body + [Op("RP", self.count(stmt) - 1, stmt.span)]
-        # every T: wait T, then RP,RP = 65536 x 65536 passes, "forever" (§3.8.6 Example 1)
-        return body + [Op("WA", self.value(stmt.period) or 0, stmt.span),
-                       Op("RP", None, stmt.span), Op("RP", None, stmt.span)]
+            # RP n runs the line n+1 times; two RPs multiply (program.rp_counts)
+            return body + [Op("RP", n, stmt.span) for n in rp_counts(self.count(stmt))]
+        # every T: wait T (several WAs past 65535 ms), then RP,RP = 65536 x 65536
+        # passes, "forever" (§3.8.6 Example 1)
+        waits = [Op("WA", ms, stmt.span) for ms in wait_pieces(self.value(stmt.period) or 0)]
+        return body + waits + [Op("RP", None, stmt.span), Op("RP", None, stmt.span)]
 
     def conditions(self, stmt: ast.When) -> list:
         return [Op("XF" if c.negated else "XN", self.value(c.value), c.span)
@@ -136,7 +199,26 @@ class _Lowerer:
     def count(self, stmt: ast.Repeat) -> int:
         """The repeat count; an invalid one (already reported) counts as 1."""
         count = self.value(stmt.count)
-        return count if count and count > 0 else 1
+        return count if count is not None and (count == 0 or rp_counts(count)) else 1
+
+    def once(self, stmt) -> bool:
+        """Whether a loop's body runs once: `repeat 1`, or a body that ends in a goto."""
+        return (isinstance(stmt, ast.Repeat) and self.count(stmt) == 1) or _ends_in_goto(
+            stmt.body, self.count)
+
+    def unrollable(self, stmt: ast.Repeat) -> bool:
+        """A repeat of plain commands that fits one macro when written out."""
+        plain = all(isinstance(s, ast.Command) and s in self.env.ops
+                    and self.env.ops[s].mnemonic not in _STAY for s in stmt.body)
+        return plain and len(stmt.body) * self.count(stmt) <= MAX_COMMANDS
+
+    def inline(self, stmt: ast.Call) -> bool:
+        """Whether to run the callee's body in place of a call with code after it."""
+        if stmt.name not in self.inlinable or self.budget <= 0:
+            return False
+        self.budget -= len(self.env.macros[stmt.name].body)
+        self.inlined.add(stmt.name)
+        return True
 
     def value(self, v: ast.Value) -> int | None:
         return self.env.values.get(v)
@@ -153,26 +235,44 @@ class _Lowerer:
                 m.ops = [self.env.ops[c] for c in item.commands if c in self.env.ops]
             elif isinstance(item, ast.Autostart):
                 m = self.new("autostart", "autostart", item.span, 0)
-                m.ops = self.seq(item.body, m, at_start=True, loop=False)
+                m.ops = self.seq(item.body, m, at_start=True, loop=False) or _nothing(item.span)
             elif isinstance(item, ast.MacroDef) and item.name in self.named:
                 m = self.named[item.name]
                 if self.env.macros[item.name] is item:
-                    m.ops = self.seq(item.body, m, at_start=True, loop=False)
+                    m.ops = self.seq(item.body, m, at_start=True, loop=False) or _nothing(item.span)
+
+    def calling(self) -> set[str]:
+        """The named macros whose lowered line calls on (contains an EM)."""
+        return {m.name for m in self.order if m.origin == "macro" and any(map(_is_em, m.ops))}
 
     def split(self) -> None:
-        """Fit lowered macros into 16 commands (MS176E §3.8) where the meaning allows.
-
-        A line without RP is chained through a tail EM. A loop (RP repeats the
-        whole line) keeps its line and moves runs of plain commands into macros
-        it calls: those call nothing, so the loop keeps its return point.
-        """
+        """Fit every lowered macro into 16 commands (MS176E §3.8) where the meaning allows."""
         for m in list(self.order):
-            if m.origin == "raw" or len(m.ops) <= MAX_COMMANDS:
-                continue
-            if any(_is_op(op, "RP") for op in m.ops):
-                self.shrink_loop(m)
-            else:
+            self.fit(m)
+
+    def fit(self, m: _Macro) -> None:
+        """Fit one macro: the part after its last RP is chained through a tail EM; the
+        part up to it stays on the line (RP repeats from the start) and moves runs of
+        plain commands into macros it calls: those call nothing, so it keeps its
+        return point."""
+        while m.origin != "raw" and len(m.ops) > MAX_COMMANDS:
+            last = max((i for i, op in enumerate(m.ops) if _is_op(op, "RP")), default=-1)
+            if last + 1 < MAX_COMMANDS:
                 self.chain(m)
+                return
+            runs = _movable_runs(m.ops[:last])
+            if not runs:
+                self.report.add("too-many-commands", m.span,
+                                f"'{m.name}' needs {len(m.ops)} commands and a macro holds "
+                                f"{MAX_COMMANDS}. It cannot be split: its RP repeats the whole "
+                                "line, and what it holds cannot move into a called macro "
+                                "(calls, conditions, TI). Move part of it into a macro of its own")
+                return
+            start, end = max(runs, key=lambda r: r[1] - r[0])
+            end = start + min(end - start, len(m.ops) - MAX_COMMANDS + 1, MAX_COMMANDS)
+            part = self.new(self.part_name(m), "part", m.span)
+            part.ops = m.ops[start:end]
+            m.ops[start:end] = [_Em(part, _span_of(part.ops[0], m.span), "hoist")]
 
     def part_name(self, m: _Macro) -> str:
         """'jog.part2', 'jog.part3', ...: the next free part name of a split macro."""
@@ -190,23 +290,6 @@ class _Lowerer:
             tail.ops, part.ops = part.ops[keep:], part.ops[:keep]
             part.ops.append(_Em(tail, _span_of(tail.ops[0], m.span), "continue"))
             part = tail
-
-    def shrink_loop(self, m: _Macro) -> None:
-        while len(m.ops) > MAX_COMMANDS:
-            runs = _movable_runs(m.ops)
-            if not runs:
-                self.report.add("too-many-commands", m.span,
-                                f"'{m.name}' needs {len(m.ops)} commands and a macro holds "
-                                f"{MAX_COMMANDS}. It cannot be split: its RP repeats the whole "
-                                "line, and what it holds cannot move into a called macro "
-                                "(calls, conditions, TI). Move part of it into a macro of its own")
-                return
-            start, end = max(runs, key=lambda r: r[1] - r[0])
-            end = min(end, start + MAX_COMMANDS)
-            part = self.new(self.part_name(m), "part", m.span)
-            part.ops = m.ops[start:end]
-            m.ops[start:end] = [_Em(part, _span_of(part.ops[0], m.span), "hoist")]
-
 
     def allocate(self) -> dict[int, _Macro]:
         taken: dict[int, _Macro] = {}
@@ -250,6 +333,26 @@ def _movable_runs(ops: list) -> list[tuple[int, int]]:
     return runs
 
 
+def _nothing(span: Span) -> list:
+    """An empty macro: `WA0`, a command that does nothing, so that the slot holds no
+    older macro (a bare `MDn` is no form of the manual's `MDn,<commands>`, §3.8.1)."""
+    return [Op("WA", 0, span)]
+
+
+def _ends_in_goto(body: tuple, count) -> bool:
+    """Whether a block always reaches a goto: one of its own, or one that ends a loop
+    in it that runs at all (such a loop runs once)."""
+    return any(isinstance(s, ast.Goto) or (
+        isinstance(s, (ast.Repeat, ast.Every)) and not (isinstance(s, ast.Repeat) and count(s) == 0)
+        and _ends_in_goto(s.body, count)) for s in body)
+
+
+def _has_ti(body: tuple) -> bool:
+    """Whether a TI stands in the block, at any depth."""
+    return any(s.word.upper() == "TI" if isinstance(s, ast.Command)
+               else _has_ti(getattr(s, "body", ())) for s in body)
+
+
 def _tail(cont: _Macro | None, span: Span) -> list:
     return [] if cont is None else [_Em(cont, span, "continue")]
 
@@ -265,13 +368,49 @@ def _final(op) -> Op:
 
 
 def lower(module: ast.Module, env: Env, report: Report, file: str = "") -> Program:
-    """The program a module stands for (errors are reported, never raised)."""
-    lowerer = _Lowerer(env, report)
-    lowerer.module(module)
-    lowerer.split()
+    """The program a module stands for (errors are reported, never raised).
+
+    A call with code after it to a macro that calls on would need a second
+    return point (MS176E §3.8.4): such a macro is inlined where it fits. Which
+    macros call on is known once they are lowered, so lowering runs again with
+    them inlined until nothing changes (diagnostics come from the last run).
+    """
+    candidates = _inlinable(module, env)
+    inline: frozenset = frozenset()
+    while True:
+        scratch = Report(report.file)
+        lowerer = _Lowerer(env, scratch, inline)
+        lowerer.module(module)
+        lowerer.split()
+        more = inline | (lowerer.calling() & candidates)
+        if more == inline:
+            break
+        inline = more
     slots = lowerer.allocate()
+    report.items.extend(scratch.items)
     macros = {
         slot: Macro(slot, m.name, [_final(op) for op in m.ops], m.span, m.origin)
         for slot, m in sorted(slots.items())
     }
-    return Program(macros, env.target, file)
+    return Program(macros, env.target, file, frozenset(lowerer.inlined))
+
+
+def _inlinable(module: ast.Module, env: Env) -> frozenset:
+    """Named macros whose body may run in a caller's place: those that call on only
+    because blocks of theirs were hoisted or split. One that calls or goes to a
+    macro as written is a nested call (SPEC §2), and native EM/XN/XF/RP/TI would
+    act on the caller's line."""
+
+    def plain(body) -> bool:
+        for s in body:
+            if isinstance(s, (ast.Goto, ast.Call)):
+                return False
+            if isinstance(s, ast.Command):
+                op = env.ops.get(s)
+                if op is None or op.mnemonic in _STAY:
+                    return False
+            elif not plain(s.body):
+                return False
+        return True
+
+    return frozenset(name for name, item in env.macros.items() if plain(item.body))

@@ -11,6 +11,30 @@ from mercmac.source import Span
 
 MAX_COMMANDS = 16  # MS176E §3.8: "Each macro can contain up to 16 base commands"
 SLOTS = range(32)  # MS176E §3.8.4: macros 0 to 31, 0 = autostart
+MAX_RP = 32_568  # MS176E §6.4 RP: n <= 32568
+MAX_WA = 65_535  # MS176E §6.4 WA: n <= 65535 ms
+MAX_WAITS = MAX_COMMANDS  # a period lowers to at most this many WAs (one macro of waits)
+
+
+def rp_counts(times: int) -> tuple[int, ...] | None:
+    """The RP arguments that run a line `times` times (>= 1), or None.
+
+    One `RP n` runs the line n+1 times; `RP a,RP b` runs it (a+1)(b+1) times:
+    RP b jumps back to the start, and RP a, whose counter was forgotten when
+    it fell through, starts again (SPEC §3; the manual's `RP,RP`, §3.8.6).
+    """
+    if times - 1 <= MAX_RP:
+        return (times - 1,)
+    for a in range(2, MAX_RP + 2):
+        if times % a == 0 and times // a - 1 <= MAX_RP:
+            return (a - 1, times // a - 1)
+    return None
+
+
+def wait_pieces(ms: int) -> list[int]:
+    """A wait of `ms` as WA arguments of at most 65535 each, as even as can be."""
+    n = max(1, -(-ms // MAX_WA))
+    return [ms // n + (1 if i < ms % n else 0) for i in range(n)]
 
 
 class Op(NamedTuple):
@@ -59,7 +83,7 @@ class Macro:
     @property
     def md(self) -> str:
         """The definition sent to the controller: 'MD5,MR5000,WS100' (MS176E §3.8.1)."""
-        return f"MD{self.slot},{self.line}" if self.ops else f"MD{self.slot}"
+        return f"MD{self.slot},{self.line}" if self.ops else f"MD{self.slot}"  # raw `[MCnn]` only
 
     @property
     def label(self) -> str:
@@ -71,10 +95,12 @@ class Macro:
 class Program:
     """All macros of one compiled file, by slot."""
 
-    __slots__ = ("macros", "target", "file")
+    __slots__ = ("macros", "target", "file", "inlined")
 
-    def __init__(self, macros: dict[int, Macro], target: str | None = None, file: str = ""):
+    def __init__(self, macros: dict[int, Macro], target: str | None = None, file: str = "",
+                 inlined: frozenset = frozenset()):
         self.macros, self.target, self.file = macros, target, file
+        self.inlined = inlined  # named macros whose body also runs in place of a call
 
     def __repr__(self) -> str:
         return f"Program({self.macros!r}, target={self.target!r}, file={self.file!r})"

@@ -25,6 +25,7 @@ from typing import Callable
 from mercmac.commands import C863, COMMANDS, SINGLE_CHARS, Arg
 from mercmac.compiler.program import Macro, Op, Program
 from mercmac.errors import UsageError
+from mercmac import outfile
 from mercmac.outfile import OutputError, writable_target, write_text
 from mercmac.upload import protocol
 from mercmac.vm import Machine, Options
@@ -414,7 +415,7 @@ def load_state(path: Path, model: str) -> dict[int, str]:
     except ValueError as e:
         raise _unreadable(path, f"it is not valid JSON ({e})") from None
     except OSError as e:
-        raise _unreadable(path, e.strerror or str(e)) from None
+        raise _unreadable(path, outfile.reason(e)) from None
     if not isinstance(data, dict):
         raise _unreadable(path, "it is not a JSON object")
     if unknown := [k for k in data if k not in _STATE_KEYS]:

@@ -163,8 +163,6 @@ def _open(port: str, baud: int):
 
 def _reason(e: BaseException) -> str:
     """pyserial's message, shortened: 'No such file or directory', 'port is locked by ...'."""
-    import os
-
     text = str(e).strip()
     if "exclusively lock" in text:
         return "the port is locked by another program"
@@ -172,5 +170,9 @@ def _reason(e: BaseException) -> str:
         return "the device disconnected"
     errno = getattr(e, "errno", None)
     if isinstance(errno, int) and errno > 0:
+        import os
+
         return os.strerror(errno)
-    return text or type(e).__name__
+    from mercmac.outfile import reason
+
+    return reason(e)  # words, never the tuple a termios.error prints as (5, 'Input/output error')

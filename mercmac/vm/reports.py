@@ -133,8 +133,10 @@ def _status_663(m: Machine) -> list[int]:
     t, axis = m.clock.now, m.axis
     limit = axis.limit_switch(t)
     moving = axis.moving(t)
+    macro = m.macro is not None  # a stored macro runs; a typed line (direct mode) is none
     return [
-        _bits(not m.running, not moving, axis.homing, axis.joystick > 0, m.running,
+        # bit 0 Ready: set when no macro runs, as in the manual's idle `s:03 07 00` (§6.4 TS)
+        _bits(not macro, not moving, axis.homing, axis.joystick > 0, macro,
               not axis.servo, m.brake, moving),
         _bits(limit == "negative", axis.reference_high(t), limit == "positive")
         | (m.inputs.pattern() << 4),
