@@ -19,11 +19,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mercmac.compiler import compile_file
-from mercmac.upload.emulator import Faults, VirtualController
+from mercmac.emulator.virtual import Faults, VirtualController
 from mercmac.upload.flasher import FlashOptions, flash
 from mercmac.upload.protocol import command
-from mercmac.upload.ptyserver import PtyServer
-from mercmac.upload.session import identify, open_controller
+from mercmac.emulator.ptyserver import PtyServer
+from mercmac.upload.connect import identify, open_controller
 from mercmac.upload.transport import Timing
 
 EXAMPLE4 = Path(__file__).resolve().parent.parent / "examples" / "macros" / "manual-example4-four-modes.mcm"

@@ -34,7 +34,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
 
 from mercmac.compiler import compile_source  # noqa: E402
-from mercmac.compiler.build import build  # noqa: E402
+from mercmac.compiler.ast_builder import build  # noqa: E402
 from mercmac.compiler.checks import check_module  # noqa: E402
 from mercmac.compiler.parse import parse  # noqa: E402
 from mercmac.diagnostics import Report, Severity  # noqa: E402

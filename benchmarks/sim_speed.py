@@ -83,7 +83,7 @@ def presses_at_one_instant(count: int) -> float:
     from mercmac.compiler import compile_source
     from mercmac.source import Source
     from mercmac.timespec import Press
-    from mercmac.vm.simulate import simulate
+    from mercmac.sim.simulate import simulate
 
     program = compile_source(Source("presses.mcm", "autostart {\n  every 20ms { TC 1 }\n}\n")).program
     presses = [Press((1, 2, 3, 4), 1000, 1001 + i % 2) for i in range(count)]

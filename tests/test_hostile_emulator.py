@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from mercmac.commands import COMMANDS, Arg
 from mercmac.upload import protocol
-from mercmac.upload.emulator import MAX_LINE, StateError, VirtualController
+from mercmac.emulator.virtual import MAX_LINE, StateError, VirtualController
 from test_upload_emulator import raw_port, read_for, serve
 
 SELECT = b"\x010"  # 0x01 '0': address selection of address 0

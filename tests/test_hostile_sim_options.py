@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from mercmac.cli import main
 from mercmac.timespec import MAX_MS, TimeSpecError, parse_buttons, parse_duration
-from mercmac.vm import scenario
+from mercmac.sim import scenario
 
 HUGE = "9" * 400
 LED = "[MC00] CN1,WA100,CF1\n"  # LED 1 on for 100 ms

@@ -25,10 +25,10 @@ from mercmac.outfile import OutputError
 from mercmac.source import Source
 from mercmac.timespec import Press
 from mercmac.vm import events as ev
-from mercmac.vm import record as record_module
-from mercmac.vm import session
+from mercmac.sim import record as record_module
+from mercmac.sim import run as sim_run
 from mercmac.vm.machine import Machine
-from mercmac.vm.simulate import machine_for, schedule, simulate
+from mercmac.sim.simulate import machine_for, schedule, simulate
 
 DAY_MS = 86_400_000
 PING_PONG = "macro a { goto b }\nmacro b { goto a }\nautostart { goto a }\n"
@@ -239,11 +239,11 @@ def no_temp_left(folder) -> bool:
 @pytest.mark.parametrize("failure", [KeyboardInterrupt(), OSError(28, "No space left on device")])
 def test_a_vcd_that_fails_midway_leaves_the_old_file(files, failure):
     program, old = files
-    with mock.patch("mercmac.vm.vcd.VcdObserver.close", side_effect=failure):
-        req = session.Request(file=str(program), until="20s", vcd=str(old))
+    with mock.patch("mercmac.sim.vcd.VcdObserver.close", side_effect=failure):
+        req = sim_run.Request(file=str(program), until="20s", vcd=str(old))
         with pytest.raises(KeyboardInterrupt if isinstance(failure, KeyboardInterrupt)
                            else OutputError):
-            session.run(req)
+            sim_run.run(req)
     assert old.read_text() == "the old dump\n"
     assert no_temp_left(old.parent)
 

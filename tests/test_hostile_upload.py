@@ -15,7 +15,7 @@ import time
 import pytest
 from click.testing import CliRunner
 
-from mercmac.upload.emulator import Faults, VirtualController
+from mercmac.emulator.virtual import Faults, VirtualController
 from mercmac.upload.transport import Timing
 from test_upload_emulator import serve
 

@@ -80,7 +80,7 @@ def test_names_and_spans_survive_lowering():
 
 
 def test_long_loop_moves_plain_runs_into_called_macros_and_keeps_the_meaning():
-    from mercmac.compiler.build import build
+    from mercmac.compiler.ast_builder import build
     from mercmac.compiler.checks import check_module
     from mercmac.compiler.parse import parse
     from mercmac.diagnostics import Report

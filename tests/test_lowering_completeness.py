@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import compile_text, rules
-from mercmac.compiler.build import build
+from mercmac.compiler.ast_builder import build
 from mercmac.compiler.checks import check_module
 from mercmac.compiler.parse import parse
 from mercmac.compiler.program import MAX_COMMANDS, rp_counts, wait_pieces

@@ -11,7 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import EXAMPLES, compile_text
-from mercmac.compiler.build import build
+from mercmac.compiler.ast_builder import build
 from mercmac.compiler.checks import check_module
 from mercmac.compiler.parse import parse
 from mercmac.compiler.program import MAX_COMMANDS

@@ -10,8 +10,8 @@ from mercmac.compiler import compile_file, compile_source
 from mercmac.source import Source
 from mercmac.timespec import parse_buttons
 from mercmac.vm import events as ev
-from mercmac.vm import scenario
-from mercmac.vm.simulate import machine_for, simulate
+from mercmac.sim import scenario
+from mercmac.sim.simulate import machine_for, simulate
 
 ROOT = os.path.join(os.path.dirname(__file__), "..")
 EXAMPLE4 = os.path.join(ROOT, "examples", "macros", "manual-example4-four-modes.mcm")

@@ -12,7 +12,7 @@ from click.testing import CliRunner
 
 from mercmac.compiler import compile_source
 from mercmac.source import Source
-from mercmac.upload.emulator import Faults
+from mercmac.emulator.virtual import Faults
 from mercmac.upload.survey import PortInfo
 from test_upload_emulator import EXAMPLE4, serve
 

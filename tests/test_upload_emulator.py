@@ -10,9 +10,9 @@ import pytest
 import serial
 
 from mercmac.upload import protocol
-from mercmac.upload.emulator import Faults, VirtualController
-from mercmac.upload.ptyserver import PtyServer
-from mercmac.upload.session import open_controller
+from mercmac.emulator.virtual import Faults, VirtualController
+from mercmac.emulator.ptyserver import PtyServer
+from mercmac.upload.connect import open_controller
 from mercmac.upload.transport import Timing
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs pseudo-terminals")

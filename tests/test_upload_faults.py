@@ -10,10 +10,10 @@ import time
 import pytest
 
 from mercmac.errors import EXIT_INTERRUPTED, EXIT_USAGE
-from mercmac.upload.emulator import Faults
+from mercmac.emulator.virtual import Faults
 from mercmac.upload.errors import FlashFailed, FlashInterrupted, PortError, Refused
 from mercmac.upload.flasher import FlashOptions, flash
-from mercmac.upload.session import check_model, identify, open_controller
+from mercmac.upload.connect import check_model, identify, open_controller
 from mercmac.upload.transport import Timing
 from test_upload_emulator import FAST, connect, serve
 from test_upload_flash import program_of, run_flash

@@ -6,10 +6,10 @@ import pytest
 from mercmac.compiler import compile_file, compile_source
 from mercmac.source import Source
 from mercmac.upload import protocol
-from mercmac.upload.emulator import Faults
+from mercmac.emulator.virtual import Faults
 from mercmac.upload.flasher import FlashOptions, flash
 from mercmac.upload.plan import Fate
-from mercmac.upload.session import identify
+from mercmac.upload.connect import identify
 from test_upload_emulator import EXAMPLE4, connect, eventually, serve
 
 
@@ -139,7 +139,7 @@ def test_a_socket_url_works_like_a_port(tmp_path):
     import threading
     import time
 
-    from mercmac.upload.emulator import VirtualController
+    from mercmac.emulator.virtual import VirtualController
 
     vc = VirtualController(macros={2: "TP"})
     listener = socket.socket()
@@ -161,7 +161,7 @@ def test_a_socket_url_works_like_a_port(tmp_path):
 
     threading.Thread(target=bridge, daemon=True).start()
     url = f"socket://127.0.0.1:{listener.getsockname()[1]}"
-    from mercmac.upload.session import open_controller
+    from mercmac.upload.connect import open_controller
 
     from test_upload_emulator import FAST
 

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from mercmac.compiler.program import Macro, Op, Program
 from mercmac.timespec import Press
-from mercmac.vm.simulate import simulate
+from mercmac.sim.simulate import simulate
 
 BUDGET = 3000  # executed commands
 

@@ -9,8 +9,8 @@ from mercmac.source import Source
 from mercmac.timespec import parse_buttons, parse_duration
 from mercmac.vm import Machine
 from mercmac.vm.events import MacroEntered
-from mercmac.vm.record import Folded
-from mercmac.vm.simulate import simulate
+from mercmac.sim.record import Folded
+from mercmac.sim.simulate import simulate
 
 
 def run(text: str, until: str = "10s", buttons: str = "", **kw):

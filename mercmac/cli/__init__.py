@@ -60,7 +60,7 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, limit: int | Non
     cannot be read.
     """
     def work() -> int:
-        from mercmac.render import diagnostics as render
+        from mercmac.render import report as render
         from mercmac.source import read_source
 
         results, unreadable = [], 0
@@ -125,7 +125,7 @@ def build(file: str, output: str | None, target: str | None) -> None:
     """
     def work() -> int:
         from mercmac.compiler import compile_file
-        from mercmac.render import diagnostics as render
+        from mercmac.render import report as render
 
         result = compile_file(file, target=target)
         if render.write_errors(result):

@@ -48,15 +48,15 @@ def sim(file, buttons, until, fmt, trace, vcd, vcd_limit, interactive, speed, sc
     its diagnostics are shown and the exit code is 1.
     """
     def work() -> int:
-        from mercmac.vm import session
+        from mercmac.sim import run
 
-        request = session.Request(
+        request = run.Request(
             file=file, buttons=buttons, until=until, fmt=fmt, trace=trace, vcd=vcd,
             vcd_limit_mb=vcd_limit,
             interactive=interactive, speed=speed, scenario=scenario, target=target,
             cycle_ms=cycle, servo_off=servo_off, reference_at=reference_at,
             hard_limits=hard_limits)
-        return EXIT_OK if session.run(request) else EXIT_FAILED
+        return EXIT_OK if run.run(request) else EXIT_FAILED
 
     run_guarded(work)
 

@@ -52,19 +52,19 @@ def flash(port, file, address, baud, dry_run, backup, erase_unused, reset, force
 
         from mercmac.render import upload as view
         from mercmac.render.console import write_lines
-        from mercmac.upload import flasher, session
+        from mercmac.upload import connect, flasher
         from mercmac.upload.errors import FlashInterrupted
 
         program = _compile(file, target)
         if backup:
             _check_output(Path(backup))  # a device, FIFO or folder: refused before the port opens
         options = flasher.FlashOptions(erase_unused, dry_run, reset, Path(backup) if backup else None)
-        with session.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
+        with connect.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
             try:
-                who = session.identify(c)
+                who = connect.identify(c)
                 if program.target is None:
                     program = _compile(file, who.version.model)
-                warning = session.check_model(who, program.target, file, force=force)
+                warning = connect.check_model(who, program.target, file, force=force)
                 write_lines(view.identity_lines(port, address, who, warning))
             except KeyboardInterrupt:
                 raise FlashInterrupted("interrupted before the first write; nothing was written") from None
@@ -96,7 +96,7 @@ def _reporting_completion(work, finished) -> int:
 def _compile(file: str, target: str | None):
     """The program of FILE, or a refusal with its diagnostics on standard error."""
     from mercmac.compiler import compile_file
-    from mercmac.render import diagnostics as render
+    from mercmac.render import report as render
     from mercmac.upload.errors import Refused
 
     result = compile_file(file, target=target)
@@ -124,12 +124,12 @@ def pull(port, output, address, baud, timeout) -> None:
 
         from mercmac.render import upload as view
         from mercmac.render.console import write_lines
-        from mercmac.upload import backup, session, survey
+        from mercmac.upload import backup, connect, survey
 
         to_file = output and output != "-"
         if to_file:
             _check_output(Path(output))  # refused before reading, which stops a running macro
-        with session.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
+        with connect.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
             pulled = survey.pull(c)
         if to_file:
             try:
@@ -185,9 +185,9 @@ def scan(port, baud, timeout, stop) -> None:
     def work() -> int:
         from mercmac.render import upload as view
         from mercmac.render.console import write_lines
-        from mercmac.upload import session, survey
+        from mercmac.upload import connect, survey
 
-        with session.open_controller(port, 0, baud=baud, timing=_timing(timeout)) as c:
+        with connect.open_controller(port, 0, baud=baud, timing=_timing(timeout)) as c:
             found = survey.scan(c.transport, stop=stop)
         write_lines(view.scan_lines(found, port))
         return EXIT_OK if survey.answered(found) else EXIT_FAILED
@@ -215,8 +215,8 @@ def emulate(target, address, state, firmware, tm_framing, empty_slot) -> None:
     def work() -> int:
         from pathlib import Path
 
-        from mercmac.upload.emulator import Faults, VirtualController
-        from mercmac.upload.ptyserver import PtyServer
+        from mercmac.emulator.virtual import Faults, VirtualController
+        from mercmac.emulator.ptyserver import PtyServer
 
         vc = VirtualController(target.upper(), address, firmware=firmware,
                                state=Path(state) if state else None,

@@ -23,9 +23,9 @@ class Compilation(NamedTuple):
 
 def compile_source(source: Source, target: str | None = None) -> Compilation:
     """Compile text; `target` (from --target) overrides the file's `target` line."""
-    from mercmac.compiler.build import build
+    from mercmac.compiler.ast_builder import build
     from mercmac.compiler.checks import check_module
-    from mercmac.compiler.flow import check_program
+    from mercmac.compiler.program_checks import check_program
     from mercmac.compiler.lower import lower
     from mercmac.compiler.parse import parse
 

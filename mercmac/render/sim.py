@@ -8,8 +8,8 @@ from typing import IO
 from mercmac.render.console import Line, write_lines
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
-from mercmac.vm.record import Folded, Recorder
-from mercmac.vm.simulate import Run
+from mercmac.sim.record import Folded, Recorder
+from mercmac.sim.simulate import Run
 
 ON, OFF = "●", "○"
 TEXT_LIMIT = 2000  # timeline lines shown as text; JSON keeps SPEC §5's 10,000

@@ -6,9 +6,9 @@ Layers, each with its own error type that the next one up rewords
     protocol.py    bytes: address codes, CR framing, report parsing  -> ProtocolError
     transport.py   pyserial with a timeout on every read             -> TransportError
     controller.py  commands to one controller: VE, TM, TZ, MD, RM     -> ControllerError
-    session.py, plan.py, flasher.py, backup.py, survey.py            -> errors.UploadError
+    connect.py, plan.py, flasher.py, backup.py, survey.py            -> errors.UploadError
     mercmac/cli/upload.py                                            the click commands
 
-emulator.py and ptyserver.py are the virtual controller behind `mercmac emulate`
-and the tests.
+The virtual controller behind `mercmac emulate` and the tests is its own
+package, `mercmac.emulator`.
 """

@@ -16,7 +16,7 @@ from mercmac.upload import backup, protocol
 from mercmac.upload.controller import Controller, ControllerError, LinkLost
 from mercmac.upload.errors import FlashFailed, FlashInterrupted, Refused
 from mercmac.upload.plan import Action, Plan, Step, make_plan
-from mercmac.upload.session import Identity, refusal
+from mercmac.upload.connect import Identity, refusal
 
 CLEANUP_TIMEOUT = 0.5  # s: after Ctrl-C, how long one tidy-up read may take
 

@@ -7,7 +7,7 @@ from mercmac.upload import backup
 from mercmac.upload.controller import BadReply, Controller, ControllerError, Flood, LinkLost
 from mercmac.upload.errors import UploadError
 from mercmac.upload.protocol import Status, Version
-from mercmac.upload.session import Identity, identify, refusal
+from mercmac.upload.connect import Identity, identify, refusal
 from mercmac.upload.transport import Transport
 
 PI_VENDOR = 0x1A72  # USB vendor id of Physik Instrumente

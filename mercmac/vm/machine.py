@@ -21,7 +21,7 @@ from mercmac.vm.clock import Clock
 from mercmac.vm.disasm import instruction
 from mercmac.vm.fastforward import Anchors, Visit, same_pass, skippable
 from mercmac.vm.hazards import HazardLog
-from mercmac.vm.io import Inputs, Outputs
+from mercmac.vm.lines import Inputs, Outputs
 from mercmac.vm.models import DEFAULTS, Options, model_name
 from mercmac.vm.motion import Axis
 from mercmac.vm.opcodes import Opcode

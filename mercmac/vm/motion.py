@@ -11,7 +11,7 @@ import math
 
 from mercmac.commands import MAX_POSITION
 from mercmac.vm.models import Defaults, Options
-from mercmac.vm.profile import PER_S, PER_S2, Segment, plan, stop
+from mercmac.vm.trapezoid import PER_S, PER_S2, Segment, plan, stop
 
 INF = math.inf
 

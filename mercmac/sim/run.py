@@ -9,7 +9,7 @@ from mercmac.errors import UsageError
 from mercmac.outfile import replacing, writable_target
 from mercmac.timespec import TimeSpecError, parse_buttons, parse_duration
 from mercmac.vm.models import Options
-from mercmac.vm.simulate import DEFAULT_UNTIL_MS, Run, machine_for, schedule, simulate
+from mercmac.sim.simulate import DEFAULT_UNTIL_MS, Run, machine_for, schedule, simulate
 
 
 @dataclass(frozen=True, slots=True)
@@ -37,7 +37,7 @@ def run(req: Request) -> bool:
     """Carry out a request; False when the file has errors or a scenario fails."""
     from mercmac.vm.clock import CycleError
     from mercmac.vm.models import ModelError
-    from mercmac.vm.scenario import ScenarioError
+    from mercmac.sim.scenario import ScenarioError
 
     try:
         return _run(req)
@@ -58,7 +58,7 @@ def _run(req: Request) -> bool:
         return False
     common = dict(model=req.target or program.target, cycle_ms=req.cycle_ms, options=options)
     if req.interactive:
-        from mercmac.vm import interactive
+        from mercmac.sim import interactive
         from mercmac.vm.machine import Machine
 
         machine = Machine(program, **common)
@@ -88,7 +88,7 @@ def _simulate(req: Request, program, presses, until: int, common: dict) -> Run:
 
 
 def _scenario(req: Request, program, presses, common: dict) -> bool:
-    from mercmac.vm import scenario
+    from mercmac.sim import scenario
 
     plan = scenario.load(req.scenario)
     until = _until(req.until, plan.until_ms)
@@ -119,10 +119,10 @@ def _render(req: Request, result: Run) -> None:
 def _compile(req: Request):
     """The program, or None after showing the errors (a file with errors is not simulated)."""
     from mercmac.compiler import compile_file
-    from mercmac.render import diagnostics
+    from mercmac.render import report
 
     compiled = compile_file(req.file, target=req.target)
-    if diagnostics.write_errors(compiled):
+    if report.write_errors(compiled):
         return None
     return compiled.program
 

@@ -8,7 +8,7 @@ from mercmac.compiler.program import Program
 from mercmac.timespec import Press
 from mercmac.vm.machine import Machine
 from mercmac.vm.models import Options
-from mercmac.vm.record import Recorder
+from mercmac.sim.record import Recorder
 
 DEFAULT_UNTIL_MS = 10_000  # SPEC §5: --until defaults to 10s
 
@@ -68,7 +68,7 @@ def simulate(program: Program, *, presses: Iterable[Press] = (), until_ms: int =
                                   trace=trace)
     dump = None
     if vcd is not None:
-        from mercmac.vm.vcd import VcdObserver
+        from mercmac.sim.vcd import VcdObserver
 
         dump = VcdObserver(vcd, record.on_event, vcd_limit)
         machine.on_event = dump.on_event

@@ -13,7 +13,7 @@ import threading
 import time
 import tty
 
-from mercmac.upload.emulator import VirtualController
+from mercmac.emulator.virtual import VirtualController
 
 TICK_S = 0.002  # how often running macros advance when no bytes arrive
 log = logging.getLogger(__name__)

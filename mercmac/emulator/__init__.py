@@ -1,0 +1,5 @@
+"""The virtual controller behind `mercmac emulate` and the uploader's tests (SPEC §4).
+
+    virtual.py     VirtualController: the firmware's serial front end over the VM
+    ptyserver.py   serves it on a pseudo-terminal that opens like a serial port
+"""
