@@ -18,6 +18,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from mercmac import mdtext
 from mercmac.compiler import compile_file
 from mercmac.emulator.virtual import Faults, VirtualController
 from mercmac.upload.flasher import FlashOptions, flash
@@ -57,10 +58,10 @@ def listing(macros: dict[int, str], framing: str = "etx-per-line") -> int:
 def minimum(before: dict[int, str], written: dict[int, str], framing: str = "etx-per-line") -> int:
     """The least traffic: back up every slot, send the MD lines, read each written one back."""
     others = {s: t for s, t in before.items() if s}
-    backup = len(command("TM")) + listing(others, framing) + len(command("TZ")) + listing(
+    backup = len(command(mdtext.tm())) + listing(others, framing) + len(command(mdtext.tz())) + listing(
         {0: before[0]} if 0 in before else {})
-    md = sum(len(command(f"MD{s},{t}")) for s, t in written.items())
-    verify = sum(len(command("TZ" if s == 0 else f"TM{s}")) + listing({s: t})
+    md = sum(len(command(mdtext.md(s, t))) for s, t in written.items())
+    verify = sum(len(command(mdtext.tell(s))) + listing({s: t})
                  for s, t in written.items())
     return backup + md + verify
 

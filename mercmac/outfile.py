@@ -112,6 +112,31 @@ def write_text(path: str | os.PathLike, text: str, *, encoding: str = "utf-8",
     return writable_target(path)
 
 
+def appending(path: str | os.PathLike, *, encoding: str = "utf-8") -> IO[str]:
+    """PATH opened to add text at its end as it goes (a log), created if new; OutputError
+    for anything but a regular file. The kind is checked again on what was opened, without
+    blocking (O_NONBLOCK), so a FIFO or device put there after the check is refused too."""
+    target = writable_target(path)
+    flags = (os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NONBLOCK", 0)
+             | getattr(os, "O_NOCTTY", 0))
+    try:
+        fd = os.open(target, flags, 0o666)
+    except OSError as e:
+        raise OutputError(f"cannot write {path}: {reason(e)}") from None
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            kind = next((name for test, name in _KINDS if test(mode)), "not a regular file")
+            raise OutputError(f"cannot write {path}: it is {kind}, not a regular file",
+                              hint="give the path of a file to create or add to")
+        if hasattr(os, "O_NONBLOCK"):
+            os.set_blocking(fd, True)
+        return os.fdopen(fd, "a", encoding=encoding, newline="\n", buffering=1)
+    except BaseException:
+        os.close(fd)
+        raise
+
+
 def _copy_mode(target: Path, tmp: str) -> None:
     """The replaced file's permissions (and owner, when allowed); a new file gets the umask's."""
     try:

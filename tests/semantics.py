@@ -1,5 +1,6 @@
-"""Two small, time-free interpreters for tests: the high-level meaning of a
-module, and the firmware's execution of a lowered program (SPEC §3).
+"""The tests' reference semantics, time-free: the high-level meaning of a module, and
+the one reference interpreter of the firmware (SPEC §3), `Firmware`, that both the
+lowering tests and the VM's differential test run.
 
 Both record the "effects" (every command that is not control flow) until the
 program ends or a budget runs out, so traces can be compared.
@@ -84,47 +85,88 @@ def high_level_trace(module: ast.Module, env: Env, inputs: set[int], limit: int 
     return trace
 
 
+class Firmware:
+    """The controller's execution of stored lines, straight from SPEC §3, without time.
+
+    `lines` is {slot: [(mnemonic, arg)]}; `inputs` are held for the whole run. Every
+    command that is not control flow is an effect (`effects`, as text); the outputs
+    pattern after each change of CN/CF/CP (`patterns`) and what TI and TB report
+    (`reports`) are kept too, so that the VM can be compared with it
+    (test_vm_differential) and lowered programs with their source (test_properties).
+    """
+
+    def __init__(self, lines: dict[int, list[tuple[str, int | None]]], inputs: set[int],
+                 limit: int | None = None):
+        self.lines, self.inputs, self.limit = lines, inputs, limit
+        self.effects: list[str] = []
+        self.reports: list[str] = []
+        self.patterns: list[int] = []
+        self.outputs = 0
+
+    def run(self, steps: int = 200_000) -> bool:
+        """Run macro 0; True if the program ended (or `limit` effects were made) within
+        `steps` executed commands."""
+        if 0 not in self.lines:
+            return True
+        slot, pc, return_point = 0, 0, None
+        counters: dict[tuple[int, int], int] = {}  # (slot, index of the RP) -> count
+        jumped: dict[int, int] = {}  # slot -> index of the RP that last jumped (for TI)
+        for _ in range(steps):
+            line = self.lines[slot]
+            exit_macro = pc >= len(line)
+            if not exit_macro:
+                name, n = line[pc]
+                pc += 1
+                if name == "EM":
+                    if n in self.lines:  # EM to an empty slot does nothing
+                        # "stores 'continue after this EM in the current macro' ... and starts n"
+                        return_point, slot, pc = (slot, pc), n, 0
+                        for key in [k for k in counters if k[0] == n]:
+                            del counters[key]  # "Counters of a macro reset when it is entered"
+                        jumped.pop(n, None)
+                elif name == "RP":
+                    key = (slot, pc - 1)
+                    first = 65535 if n is None else n  # a bare RP means 65535
+                    counters[key] = first if key not in counters else counters[key] - 1
+                    if counters[key] > 0:
+                        jumped[slot], pc = pc - 1, 0
+                    else:
+                        del counters[key]  # a later arrival starts again
+                elif name in ("XN", "XF"):
+                    exit_macro = (n in self.inputs) != (name == "XN")
+                elif self._effect(name, n, counters.get((slot, jumped.get(slot)), 0)):
+                    return True
+            if exit_macro:  # the macro ends: return, or the program ends
+                if return_point is None:
+                    return True
+                (slot, pc), return_point = return_point, None
+        return False
+
+    def _effect(self, name: str, n: int | None, remaining: int) -> bool:
+        """Record one effect; True when `limit` effects are recorded."""
+        self.effects.append(name if n is None else f"{name}{n}")
+        before = self.outputs
+        if name == "CN":
+            self.outputs |= 1 << (n - 1)
+        elif name == "CF":
+            self.outputs &= ~(1 << (n - 1))
+        elif name == "CP":
+            self.outputs = n
+        elif name == "TI":  # the remaining count of the RP that last jumped
+            self.reports.append(f"X:{remaining:+011d}")
+        elif name == "TB":
+            self.reports.append("B:0")
+        if self.outputs != before:
+            self.patterns.append(self.outputs)
+        return self.limit is not None and len(self.effects) >= self.limit
+
+
 def firmware_trace(lines: dict[int, list[tuple[str, int | None]]], inputs: set[int],
                    limit: int = 200, steps: int = 200_000) -> list[str]:
-    """Run macro 0 of stored lines {slot: [(mnemonic, arg)]} straight from SPEC §3."""
-    trace: list[str] = []
-    slot, pc, counters, ret = 0, 0, {}, None
-    for _ in range(steps):
-        ops = lines[slot]
-        if pc >= len(ops):  # the macro ends: return, or the program ends
-            if ret is None:
-                return trace
-            (slot, pc, counters), ret = ret, None
-            continue
-        name, arg = ops[pc]
-        if name == "EM":
-            if arg in lines:  # EM to an empty slot does nothing
-                ret = (slot, pc + 1, counters)
-                slot, pc, counters = arg, 0, {}
-                continue
-        elif name in ("XN", "XF"):
-            if (arg in inputs) != (name == "XN"):
-                pc = len(ops)
-                continue
-        elif name == "RP":
-            n = 65535 if arg is None else arg
-            if pc not in counters:
-                counters[pc] = n
-                if n > 0:
-                    pc = 0
-                    continue
-            else:
-                counters[pc] -= 1
-                if counters[pc] > 0:
-                    pc = 0
-                    continue
-                del counters[pc]
-        else:
-            trace.append(name if arg is None else f"{name}{arg}")
-            if len(trace) >= limit:
-                return trace
-        pc += 1
-    return trace + [CUT]
+    """The effects of running macro 0 of stored lines, ending in CUT when the step budget
+    ran out first."""
+    firmware = Firmware(lines, inputs, limit)
+    return firmware.effects + ([] if firmware.run(steps) else [CUT])
 
 
 def _merged(trace: list[str]) -> list[str]:

@@ -16,7 +16,8 @@ FINDS = [
     ("syntax", "[MC01] EMxx\n", None),
     ("syntax", "MR5000\n", None),
     ("syntax", "macro a {\n  TP\n", None),
-    ("syntax", "macro a { goto b, TP }\nmacro b { TP }\n", None),
+    ("goto-not-last", "macro a { goto b, TP }\nmacro b { TP }\n", None),
+    ("goto-not-last", "autostart { when 1 { goto b, CN 1 } }\nmacro b { TP }\n", None),
     # issue 8: a goto that ends a loop parsed fine; it is a warning, not `syntax`
     ("goto-ends-loop", "macro a { repeat 3 { MR 5, goto b } }\nmacro b { TP }\n", None),
     ("goto-ends-loop", "macro x { TP }\nautostart { repeat 3 { CN 1, TT, goto x }, CN 2 }\n", None),
@@ -69,7 +70,7 @@ FINDS = [
     ("duplicate-slot", "macro a @1 { TP }\n[MC01] TT\n", None),
     ("duplicate-slot", "autostart { TP }\n[MC00] TT\n", None),
     ("duplicate-slot", "autostart { TP }\nautostart { TT }\n", None),
-    ("duplicate-slot", "macro a { TP }\nmacro a { TT }\n", None),
+    ("duplicate-name", "macro a { TP }\nmacro a { TT }\n", None),
     ("sc-outside-autostart", "[MC01] SC0\n", None),
     ("sc-outside-autostart", "autostart { when 1 { SC 0 }, TP }\n", None),
     ("not-in-macro", "[MC01] MD5\n", None),
@@ -121,6 +122,9 @@ CLEAN = [
     ("nested-call", "macro g { goto m }\nmacro m { CP 3 }\nautostart { CN 1, call g }\n", None),
     ("nested-call", "macro r { repeat 3 { MR 10, TT }, CN 2 }\nautostart { call r, TP }\n", None),
     ("syntax", "macro x { TP }\nautostart { repeat 3 { CN 1, TT, goto x }, CN 2 }\n", None),
+    ("goto-not-last", "macro x { TP }\nautostart { repeat 3 { CN 1, TT, goto x }, CN 2 }\n", None),
+    ("syntax", "macro a { goto b, TP }\nmacro b { TP }\n", None),
+    ("duplicate-slot", "macro a { TP }\nmacro a { TT }\n", None),
     ("argument-range", "autostart { repeat 40000 { TP }, every 70000ms { TP }, repeat 0 { TP } }\n", None),
     ("too-many-commands", "autostart { repeat 3 { " + ", ".join(f"MR {i}" for i in range(1, 16))
      + ", TT }, CP 1 }\n", None),

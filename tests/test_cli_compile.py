@@ -8,7 +8,7 @@ import sys
 
 from click.testing import CliRunner
 
-from conftest import EXAMPLES, ROOT
+from conftest import EXAMPLES, ROOT, cli
 from mercmac.cli import main
 
 EX4 = str(EXAMPLES / "manual-example4-four-modes.mcm")
@@ -16,17 +16,13 @@ EX3 = str(EXAMPLES / "manual-example3-operator-moves.mcm")
 FOUR = str(EXAMPLES / "four-modes.mcm")
 
 
-def run(*args, **kw):
-    return CliRunner().invoke(main, list(args), catch_exceptions=False, **kw)
-
-
 def test_check_clean_file_exits_0():
-    r = run("check", FOUR)
+    r = cli("check", FOUR)
     assert r.exit_code == 0 and "No problems found in 1 file." in r.output
 
 
 def test_check_with_errors_exits_1_errors_first_and_a_count():
-    r = run("check", EX3, EX4)
+    r = cli("check", EX3, EX4)
     assert r.exit_code == 1
     lines = [l for l in r.output.splitlines() if "[MM" in l]
     severities = [l.split(": ")[1].split("[")[0] for l in lines]
@@ -35,12 +31,12 @@ def test_check_with_errors_exits_1_errors_first_and_a_count():
 
 
 def test_check_unreadable_file_exits_2(tmp_path):
-    r = run("check", str(tmp_path / "missing.mcm"))
+    r = cli("check", str(tmp_path / "missing.mcm"))
     assert r.exit_code == 2 and "cannot read" in r.output
 
 
 def test_check_json_is_spec_shaped():
-    r = run("check", "--format", "json", EX3)
+    r = cli("check", "--format", "json", EX3)
     data = json.loads(r.output)
     assert r.exit_code == 1
     first = data["diagnostics"][0]
@@ -52,13 +48,13 @@ def test_check_json_is_spec_shaped():
 def test_check_target_option_overrides_file(tmp_path):
     prog = tmp_path / "p.mcm"
     prog.write_text("target C-863\n[MC01] DP200\n")
-    assert run("check", str(prog)).exit_code == 0
-    r = run("check", "--target", "C-663", str(prog))
+    assert cli("check", str(prog)).exit_code == 0
+    r = cli("check", "--target", "C-663", str(prog))
     assert r.exit_code == 1 and "model-unsupported" in r.output
 
 
 def test_build_prints_md_lines_macro_0_last():
-    r = run("build", EX4)
+    r = cli("build", EX4)
     lines = r.output.splitlines()
     assert r.exit_code == 0 and lines[-1] == "MD0,EM9,EM10" and lines[0].startswith("MD9,BF,DP200")
     assert len(lines) == 23
@@ -66,7 +62,7 @@ def test_build_prints_md_lines_macro_0_last():
 
 def test_build_writes_output_file(tmp_path):
     out = tmp_path / "prog.md"
-    r = run("build", FOUR, "-o", str(out))
+    r = cli("build", FOUR, "-o", str(out))
     assert r.exit_code == 0 and r.output == ""
     assert out.read_text().splitlines()[-1].startswith("MD0,")
 
@@ -78,13 +74,13 @@ def test_build_refuses_on_errors():
 
 
 def test_explain_by_code_and_name():
-    by_code, by_name = run("explain", "MM011"), run("explain", "nested-call")
+    by_code, by_name = cli("explain", "MM011"), cli("explain", "nested-call")
     assert by_code.exit_code == 0 and by_code.output == by_name.output
     assert "§3.8.4" in by_code.output
 
 
 def test_explain_unknown_rule_exits_2():
-    r = run("explain", "no-such-rule")
+    r = cli("explain", "no-such-rule")
     assert r.exit_code == 2 and "no rule" in r.output
 
 

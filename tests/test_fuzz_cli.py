@@ -22,7 +22,7 @@ from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, leftovers
 from mercmac.cli import main
 
 BUDGET = settings(
@@ -108,10 +108,6 @@ def invoke(args: list[str], input: str | None = None):
         f"traceback for mercmac {' '.join(args)[:300]!r}: {result.exception!r}\n{result.output[-2000:]}")
     assert result.exit_code in KNOWN_EXITS, (args, result.exit_code, result.output[-2000:])
     return result
-
-
-def leftovers(folder: Path) -> list[str]:
-    return sorted(p.name for p in folder.iterdir() if p.name.startswith(".mercmac-"))
 
 
 @BUDGET

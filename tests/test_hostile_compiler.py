@@ -12,6 +12,7 @@ from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from conftest import cli
 from mercmac.cli import main
 from mercmac.compiler import compile_source
 from mercmac.source import Source, decode
@@ -23,10 +24,6 @@ def diagnostics(text: str):
 
 def found(text: str) -> list[tuple[str, int, int]]:
     return [(d.rule.name, d.span.line, d.span.column) for d in diagnostics(text)]
-
-
-def run(*args):
-    return CliRunner().invoke(main, list(args), catch_exceptions=False)
 
 
 # -- numbers the compiler cannot use -----------------------------------------------------
@@ -99,26 +96,26 @@ def test_source_lines_are_counted_as_the_parser_counts_them():
 def test_text_output_is_capped_per_file_with_a_count(tmp_path):
     f = tmp_path / "many.mcm"
     f.write_text("[MC01] MR5000 WS100\n" * 250)
-    r = run("check", str(f))
+    r = cli("check", str(f))
     assert r.exit_code == 1
     assert r.output.count("error[MM001 syntax]") == 200
     assert "50 more diagnostics not shown" in r.output and "--max-diagnostics 0" in r.output
     assert r.output.rstrip().endswith("250 errors, 0 warnings, 0 infos in 1 file.")
-    assert run("check", "--max-diagnostics", "0", str(f)).output.count("error[MM001") == 250
+    assert cli("check", "--max-diagnostics", "0", str(f)).output.count("error[MM001") == 250
 
 
 def test_json_output_is_capped_with_truncated_counts(tmp_path):
     f = tmp_path / "many.mcm"
     f.write_text("[MC01] MR5000 WS100\n" * 30)
-    data = json.loads(run("check", "--format", "json", "--max-diagnostics", "10", str(f)).output)
+    data = json.loads(cli("check", "--format", "json", "--max-diagnostics", "10", str(f)).output)
     assert len(data["diagnostics"]) == 10 and data["truncated"] == {str(f): 20}
-    assert "truncated" not in json.loads(run("check", "--format", "json", str(f)).output)
+    assert "truncated" not in json.loads(cli("check", "--format", "json", str(f)).output)
 
 
 def test_a_long_line_is_shown_as_a_window_around_the_caret(tmp_path):
     f = tmp_path / "long.mcm"
     f.write_text("[MC01] " + "TP," * 5000 + "XX1\n")
-    r = run("check", str(f))
+    r = cli("check", str(f))
     lines = r.output.splitlines()
     i = next(i for i, line in enumerate(lines) if "unknown-command" in line)
     shown, caret = lines[i + 1], lines[i + 2]
@@ -129,7 +126,7 @@ def test_a_long_line_is_shown_as_a_window_around_the_caret(tmp_path):
 def test_control_characters_never_reach_the_terminal(tmp_path):
     f = tmp_path / "esc.mcm"
     f.write_text("[MC01] TP\x1b]0;pwned\x07\x1b[2J\n[MC02] \x1b[2JXX\n[MC03] TP\u202e\n")
-    r = run("check", str(f))
+    r = cli("check", str(f))
     assert r.exit_code == 1
     assert not any(c in r.output for c in "\x1b\x07\u202e")
     assert "\\x1b[2J" in r.output
@@ -153,7 +150,7 @@ def test_unicode_files_with_a_bom_are_read(tmp_path, codec):
     if codec.endswith("-be"):
         data = "\ufeff".encode(codec) + data
     f.write_bytes(data)
-    r = run("check", str(f))
+    r = cli("check", str(f))
     assert r.exit_code == 0 and "No problems found" in r.output
 
 
@@ -164,7 +161,7 @@ def test_utf16_without_bom_is_read():
 def test_binary_file_says_so(tmp_path):
     f = tmp_path / "b.mcm"
     f.write_bytes(bytes(range(256)) * 4)
-    r = run("check", str(f))
+    r = cli("check", str(f))
     assert r.exit_code == 1 and "binary file" in r.output and r.output.count("[MM") == 1
 
 
@@ -184,7 +181,7 @@ def test_a_compiler_crash_is_an_error_on_that_file_and_the_others_go_on(tmp_path
     bad, good = tmp_path / "bad.mcm", tmp_path / "good.mcm"
     bad.write_text("[MC01] TP\n")
     good.write_text("[MC01] TQ\n")
-    r = run("check", str(bad), str(good))
+    r = cli("check", str(bad), str(good))
     assert r.exit_code == 1
     assert f"{bad}:1:1: error" in r.output and "internal error" in r.output
     assert "RecursionError" in r.output and "unknown-command" in r.output
@@ -196,7 +193,7 @@ def test_hostile_files_do_not_stop_check(tmp_path):
              "d.mcm": "[MC01] TQ\n"}
     for name, text in files.items():
         (tmp_path / name).write_text(text)
-    r = run("check", *(str(tmp_path / n) for n in files))
+    r = cli("check", *(str(tmp_path / n) for n in files))
     assert r.exit_code == 1 and "internal error" not in r.output
     for name in files:
         assert f"{tmp_path / name}:" in r.output

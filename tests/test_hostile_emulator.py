@@ -34,8 +34,11 @@ class Session:
 
     def send(self, data: bytes) -> bytes:
         self.vc.receive(data, self.now)
-        self.now += 0.002  # a command takes a cycle: its report comes on the next tick
-        self.vc.tick(self.now)
+        for _ in range(20):  # bytes after a line wait until its commands ran (up to 17 cycles)
+            self.now += 0.002  # a command takes a cycle: its report comes on the next tick
+            self.vc.tick(self.now)
+            if not self.vc.waiting:
+                break
         return self.vc.take()
 
     def ask(self, line: str) -> str:

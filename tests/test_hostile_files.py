@@ -12,11 +12,10 @@ import stat
 import subprocess
 import sys
 import termios
-from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
+from conftest import cli, leftovers
 from mercmac import outfile
 from test_upload_emulator import serve
 
@@ -25,23 +24,6 @@ BUILT = "MD5,MR5000,WS100\nMD0,EM5\n"
 FAST = ["--timeout", "0.3"]
 ROOT = os.geteuid() == 0 if hasattr(os, "geteuid") else False
 EIO = OSError(errno.EIO, os.strerror(errno.EIO))
-
-
-def mercmac(*args):
-    from mercmac.cli import main
-
-    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
-
-
-def leftovers(folder: Path) -> list[Path]:
-    return sorted(folder.glob(f"{outfile.TEMP_PREFIX}*{outfile.TEMP_SUFFIX}"))
-
-
-@pytest.fixture
-def program_file(tmp_path):
-    path = tmp_path / "prog.mcm"
-    path.write_text(PROGRAM)
-    return path
 
 
 @pytest.fixture
@@ -76,7 +58,7 @@ def fail_on(monkeypatch, name: str, error: BaseException = EIO) -> None:
 # --- build -o -----------------------------------------------------------------------------------
 
 def test_build_refuses_a_fifo_and_leaves_it_a_fifo(program_file, fifo):
-    result = mercmac("build", program_file, "-o", fifo)
+    result = cli("build", program_file, "-o", fifo)
     assert result.exit_code == 2, result.output
     assert "FIFO" in result.output and str(fifo) in result.output
     assert "Traceback" not in result.output
@@ -84,7 +66,7 @@ def test_build_refuses_a_fifo_and_leaves_it_a_fifo(program_file, fifo):
 
 
 def test_build_refuses_a_device_node(program_file, device):
-    result = mercmac("build", program_file, "-o", device)
+    result = cli("build", program_file, "-o", device)
     assert result.exit_code == 2, result.output
     assert "character device" in result.output
     assert stat.S_ISCHR(os.lstat(device).st_mode)
@@ -92,13 +74,13 @@ def test_build_refuses_a_device_node(program_file, device):
 
 @pytest.mark.skipif(not ROOT, reason="only root could turn /dev/null into a file")
 def test_build_refuses_dev_null_and_it_stays_a_device(program_file):
-    result = mercmac("build", program_file, "-o", "/dev/null")
+    result = cli("build", program_file, "-o", "/dev/null")
     assert result.exit_code == 2, result.output
     assert stat.S_ISCHR(os.lstat("/dev/null").st_mode)
 
 
 def test_build_refuses_a_folder(program_file, tmp_path):
-    result = mercmac("build", program_file, "-o", tmp_path)
+    result = cli("build", program_file, "-o", tmp_path)
     assert result.exit_code == 2
     assert tmp_path.is_dir()
 
@@ -107,7 +89,7 @@ def test_build_follows_a_symlink(program_file, tmp_path):
     target, link = tmp_path / "real.txt", tmp_path / "link.txt"
     target.write_text("old\n")
     link.symlink_to(target.name)
-    result = mercmac("build", program_file, "-o", link)
+    result = cli("build", program_file, "-o", link)
     assert result.exit_code == 0, result.output
     assert link.is_symlink() and os.readlink(link) == target.name
     assert target.read_text() == BUILT
@@ -117,14 +99,14 @@ def test_build_keeps_the_permissions(program_file, tmp_path):
     out = tmp_path / "out.txt"
     out.write_text("old\n")
     out.chmod(0o640)
-    assert mercmac("build", program_file, "-o", out).exit_code == 0
+    assert cli("build", program_file, "-o", out).exit_code == 0
     assert stat.S_IMODE(out.stat().st_mode) == 0o640 and out.read_text() == BUILT
 
 
 def test_build_new_file_gets_the_umask_permissions(program_file, tmp_path):
     mask = os.umask(0o027)
     try:
-        assert mercmac("build", program_file, "-o", tmp_path / "new.txt").exit_code == 0
+        assert cli("build", program_file, "-o", tmp_path / "new.txt").exit_code == 0
     finally:
         os.umask(mask)
     assert stat.S_IMODE((tmp_path / "new.txt").stat().st_mode) == 0o640
@@ -134,7 +116,7 @@ def test_build_failure_keeps_the_old_file_and_no_temp_file(program_file, tmp_pat
     out = tmp_path / "out.txt"
     out.write_text("old\n")
     fail_on(monkeypatch, "replace")
-    result = mercmac("build", program_file, "-o", out)
+    result = cli("build", program_file, "-o", out)
     assert result.exit_code == 2
     assert f"cannot write {out}: Input/output error" in result.output
     assert out.read_text() == "old\n" and leftovers(tmp_path) == []
@@ -164,7 +146,7 @@ def test_build_interrupted_keeps_the_old_file(program_file, tmp_path, monkeypatc
     out = tmp_path / "out.txt"
     out.write_text("old\n")
     fail_on(monkeypatch, "fsync", KeyboardInterrupt())
-    result = mercmac("build", program_file, "-o", out)
+    result = cli("build", program_file, "-o", out)
     assert result.exit_code == 130
     assert out.read_text() == "old\n" and leftovers(tmp_path) == []
 
@@ -176,7 +158,7 @@ def test_flash_refuses_a_backup_that_is_not_a_file_before_touching_the_controlle
         request, program_file, kind):
     bad = request.getfixturevalue(kind)
     with serve(macros={3: "TP"}) as (server, vc):
-        result = mercmac("flash", server.path, program_file, "--backup", bad, *FAST)
+        result = cli("flash", server.path, program_file, "--backup", bad, *FAST)
         assert result.exit_code == 2, result.output
         assert f"cannot write {bad}" in result.output and "not a regular file" in result.output
         assert vc.md_count == 0 and not vc.lines and vc.macros == {3: "TP"}
@@ -186,7 +168,7 @@ def test_flash_refuses_a_backup_that_is_not_a_file_before_touching_the_controlle
 @pytest.mark.skipif(not ROOT, reason="only root could turn /dev/null into a file")
 def test_flash_backup_to_dev_null_is_refused_and_it_stays_a_device(program_file):
     with serve() as (server, vc):
-        result = mercmac("flash", server.path, program_file, "--backup", "/dev/null", *FAST)
+        result = cli("flash", server.path, program_file, "--backup", "/dev/null", *FAST)
         assert result.exit_code == 2, result.output
         assert "character device" in result.output
         assert vc.md_count == 0 and not vc.lines
@@ -199,7 +181,7 @@ def test_flash_backup_follows_a_symlink_and_keeps_permissions(program_file, tmp_
     target.chmod(0o640)
     link.symlink_to(target)
     with serve(macros={3: "TP"}) as (server, vc):
-        result = mercmac("flash", server.path, program_file, "--backup", link, *FAST)
+        result = cli("flash", server.path, program_file, "--backup", link, *FAST)
     assert result.exit_code == 0, result.output
     assert link.is_symlink() and os.readlink(link) == str(target)
     assert "[MC03] TP" in target.read_text()
@@ -212,7 +194,7 @@ def test_flash_with_a_failing_backup_writes_nothing_and_leaves_no_temp_file(
     backup.write_text("// older backup\n")
     with serve(macros={3: "TP"}) as (server, vc):
         fail_on(monkeypatch, "fsync")
-        result = mercmac("flash", server.path, program_file, "--backup", backup, *FAST)
+        result = cli("flash", server.path, program_file, "--backup", backup, *FAST)
         monkeypatch.undo()
         assert result.exit_code == 1, result.output
         assert "Input/output error" in result.output and "nothing was written" in result.output
@@ -224,7 +206,7 @@ def test_flash_with_a_failing_backup_writes_nothing_and_leaves_no_temp_file(
 def test_default_backup_folder_is_still_created(program_file, tmp_path, monkeypatch):
     monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "no" / "such" / "data"))
     with serve(macros={3: "TP"}) as (server, vc):
-        result = mercmac("flash", server.path, program_file, *FAST)
+        result = cli("flash", server.path, program_file, *FAST)
     assert result.exit_code == 0, result.output
     [saved] = (tmp_path / "no" / "such" / "data" / "mercmac" / "backups").glob("*.mcm")
     assert "[MC03] TP" in saved.read_text()
@@ -236,7 +218,7 @@ def test_default_backup_folder_is_still_created(program_file, tmp_path, monkeypa
 def test_pull_refuses_a_path_that_is_not_a_file_before_reading(request, kind):
     bad = request.getfixturevalue(kind)
     with serve(macros={3: "TP"}) as (server, vc):
-        result = mercmac("pull", server.path, "-o", bad, *FAST)
+        result = cli("pull", server.path, "-o", bad, *FAST)
         assert result.exit_code == 2, result.output
         assert "not a regular file" in result.output
         assert not vc.lines
@@ -246,7 +228,7 @@ def test_pull_refuses_a_path_that_is_not_a_file_before_reading(request, kind):
 @pytest.mark.skipif(not ROOT, reason="only root could turn /dev/full into a file")
 def test_pull_to_dev_full_is_refused_and_it_stays_a_device():
     with serve(macros={3: "TP"}) as (server, vc):
-        result = mercmac("pull", server.path, "-o", "/dev/full", *FAST)
+        result = cli("pull", server.path, "-o", "/dev/full", *FAST)
         assert result.exit_code == 2, result.output
         assert not vc.lines
     assert stat.S_ISCHR(os.lstat("/dev/full").st_mode)
@@ -258,7 +240,7 @@ def test_pull_follows_a_symlink_and_keeps_permissions(tmp_path):
     target.chmod(0o640)
     link.symlink_to(target)
     with serve(macros={3: "TP"}) as (server, vc):
-        result = mercmac("pull", server.path, "-o", link, *FAST)
+        result = cli("pull", server.path, "-o", link, *FAST)
     assert result.exit_code == 0, result.output
     assert link.is_symlink() and "[MC03] TP" in target.read_text()
     assert stat.S_IMODE(target.stat().st_mode) == 0o640
@@ -268,7 +250,7 @@ def test_pull_follows_a_dangling_symlink(tmp_path):
     link = tmp_path / "link.mcm"
     link.symlink_to("made.mcm")
     with serve(macros={3: "TP"}) as (server, vc):
-        result = mercmac("pull", server.path, "-o", link, *FAST)
+        result = cli("pull", server.path, "-o", link, *FAST)
     assert result.exit_code == 0, result.output
     assert link.is_symlink() and "[MC03] TP" in (tmp_path / "made.mcm").read_text()
 
@@ -278,7 +260,7 @@ def test_pull_write_failure_keeps_the_old_file_and_no_temp_file(tmp_path, monkey
     out.write_text("old\n")
     with serve(macros={3: "TP"}) as (server, vc):
         fail_on(monkeypatch, "replace")
-        result = mercmac("pull", server.path, "-o", out, *FAST)
+        result = cli("pull", server.path, "-o", out, *FAST)
         monkeypatch.undo()
     assert result.exit_code == 2, result.output
     assert f"cannot write {out}: Input/output error" in result.output
@@ -298,6 +280,6 @@ def test_reason_says_the_cause_in_words(error):
 
 
 def test_an_unwritable_folder_is_named(tmp_path, program_file):
-    result = mercmac("build", program_file, "-o", tmp_path / "missing" / "out.txt")
+    result = cli("build", program_file, "-o", tmp_path / "missing" / "out.txt")
     assert result.exit_code == 2
     assert "does not exist" in result.output and str(tmp_path / "missing") in result.output

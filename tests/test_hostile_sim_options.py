@@ -7,32 +7,15 @@ from __future__ import annotations
 import os
 
 import pytest
-from click.testing import CliRunner
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mercmac.cli import main
+from conftest import sim
 from mercmac.timespec import MAX_MS, TimeSpecError, parse_buttons, parse_duration
 from mercmac.sim import scenario
 
 HUGE = "9" * 400
 LED = "[MC00] CN1,WA100,CF1\n"  # LED 1 on for 100 ms
-
-
-@pytest.fixture
-def write(tmp_path):
-    def make(text: str | bytes, name: str = "p.mcm") -> str:
-        path = tmp_path / name
-        if isinstance(text, bytes):
-            path.write_bytes(text)
-        else:
-            path.write_text(text, encoding="utf-8")
-        return str(path)
-    return make
-
-
-def sim(*args: str):
-    return CliRunner().invoke(main, ["sim", *args])
 
 
 def refused(result, *words: str) -> None:

@@ -18,11 +18,10 @@ from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from conftest import program_of
 from mercmac.cli import main
-from mercmac.compiler import compile_source
 from mercmac.compiler.program import Macro, Op, Program
 from mercmac.outfile import OutputError
-from mercmac.source import Source
 from mercmac.timespec import Press
 from mercmac.vm import events as ev
 from mercmac.sim import record as record_module
@@ -39,12 +38,6 @@ SHUTTLE = "autostart {\n  every 1s { MA 100000, WS 0, MA 0, WS 0 }\n}\n"
 
 class OverBudget(Exception):
     """More instructions executed than the test allows: the loop was not skipped."""
-
-
-def program_of(text: str) -> Program:
-    compiled = compile_source(Source("t.mcm", text))
-    assert compiled.program is not None, compiled.report
-    return compiled.program
 
 
 def run(text: str, until_ms: int, budget: int = 10_000, fast_forward: str = "all",

@@ -13,8 +13,8 @@ import threading
 import time
 
 import pytest
-from click.testing import CliRunner
 
+from conftest import cli
 from mercmac.emulator.virtual import Faults, VirtualController
 from mercmac.upload.transport import Timing
 from test_upload_emulator import serve
@@ -28,20 +28,11 @@ BOUND_S = 10  # every hostile run below must be over well before this
 
 def mercmac(*args):
     """Run a command in-process; exceptions are kept, so a traceback shows as one."""
-    from mercmac.cli import main
-
-    return CliRunner().invoke(main, [str(a) for a in args])
+    return cli(*args, catch=True)
 
 
 def no_traceback(result) -> bool:
     return result.exception is None or isinstance(result.exception, SystemExit)
-
-
-@pytest.fixture
-def program_file(tmp_path):
-    path = tmp_path / "prog.mcm"
-    path.write_text(PROGRAM)
-    return path
 
 
 # -- a misbehaving controller on socket://127.0.0.1 -----------------------------

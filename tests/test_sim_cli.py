@@ -7,25 +7,11 @@ import subprocess
 import sys
 
 import pytest
-from click.testing import CliRunner
 
-from mercmac.cli import main
+from conftest import sim
 
 ROOT = os.path.join(os.path.dirname(__file__), "..")
 EXAMPLE4 = os.path.join(ROOT, "examples", "macros", "manual-example4-four-modes.mcm")
-
-
-@pytest.fixture
-def write(tmp_path):
-    def make(text: str, name: str = "p.mcm") -> str:
-        path = tmp_path / name
-        path.write_text(text)
-        return str(path)
-    return make
-
-
-def sim(*args: str):
-    return CliRunner().invoke(main, ["sim", *args])
 
 
 def test_json_has_the_spec_shape(write):

@@ -6,8 +6,8 @@ import os
 
 import pytest
 
-from mercmac.compiler import compile_file, compile_source
-from mercmac.source import Source
+from conftest import program_of
+from mercmac.compiler import compile_file
 from mercmac.timespec import parse_buttons
 from mercmac.vm import events as ev
 from mercmac.sim import scenario
@@ -15,12 +15,6 @@ from mercmac.sim.simulate import machine_for, simulate
 
 ROOT = os.path.join(os.path.dirname(__file__), "..")
 EXAMPLE4 = os.path.join(ROOT, "examples", "macros", "manual-example4-four-modes.mcm")
-
-
-def program_of(text: str):
-    compiled = compile_source(Source("t.mcm", text))
-    assert not compiled.report.has_errors
-    return compiled.program
 
 
 def example4(buttons: str, until_ms: int):

@@ -8,8 +8,8 @@ import sys
 import time
 
 import pytest
-from click.testing import CliRunner
 
+from conftest import cli
 from mercmac.compiler import compile_source
 from mercmac.source import Source
 from mercmac.emulator.virtual import Faults
@@ -20,28 +20,14 @@ PROGRAM = "target C-863\n[MC00] EM5\n[MC05] MR5000,WS100\n"
 FAST = ["--timeout", "0.3"]
 
 
-def mercmac(*args: str):
-    """Run a command in-process through the real `main` group."""
-    from mercmac.cli import main
-
-    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
-
-
 def command_line(*args: str) -> list[str]:
     """The same, as a separate process."""
     return [sys.executable, "-m", "mercmac", *args]
 
 
-@pytest.fixture
-def program_file(tmp_path):
-    path = tmp_path / "prog.mcm"
-    path.write_text(PROGRAM)
-    return path
-
-
 def test_flash_prints_the_controller_the_table_and_the_backup(tmp_path, program_file):
     with serve() as (server, vc):
-        result = mercmac("flash", server.path, program_file, "--backup", tmp_path / "b.mcm", *FAST)
+        result = cli("flash", server.path, program_file, "--backup", tmp_path / "b.mcm", *FAST)
     assert result.exit_code == 0, result.output
     out = result.output
     assert "controller: C-863, firmware 2.30, at address 0" in out
@@ -54,7 +40,7 @@ def test_flash_prints_the_controller_the_table_and_the_backup(tmp_path, program_
 def test_default_backup_goes_to_the_per_user_data_directory(tmp_path, program_file, monkeypatch):
     monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
     with serve(macros={3: "TP"}) as (server, vc):
-        result = mercmac("flash", server.path, program_file, *FAST)
+        result = cli("flash", server.path, program_file, *FAST)
     assert result.exit_code == 0, result.output
     backups = list((tmp_path / "data" / "mercmac" / "backups").glob("*-addr0-*.mcm"))
     assert len(backups) == 1 and f"backup: {backups[0]}" in result.output
@@ -64,7 +50,7 @@ def test_default_backup_goes_to_the_per_user_data_directory(tmp_path, program_fi
 def test_a_file_with_errors_is_not_flashed(tmp_path):
     bad = tmp_path / "bad.mcm"
     bad.write_text("[MC05] MR\n")
-    result = mercmac("flash", "/dev/does-not-exist", bad, *FAST)  # the port is never opened
+    result = cli("flash", "/dev/does-not-exist", bad, *FAST)  # the port is never opened
     assert result.exit_code == 1
     assert "bad-argument" in result.output and "nothing was flashed" in result.output
 
@@ -73,7 +59,7 @@ def test_a_file_without_target_is_checked_against_the_controller(tmp_path):
     prog = tmp_path / "dc.mcm"
     prog.write_text("[MC05] DP200,MR5\n")  # DP exists on the C-863 only
     with serve(model="C-663") as (server, vc):
-        result = mercmac("flash", server.path, prog, *FAST)
+        result = cli("flash", server.path, prog, *FAST)
     assert result.exit_code == 1
     assert "model-unsupported" in result.output and "errors for the C-663" in result.output
     assert vc.md_count == 0
@@ -81,16 +67,16 @@ def test_a_file_without_target_is_checked_against_the_controller(tmp_path):
 
 def test_wrong_model_needs_force(tmp_path, program_file):
     with serve(model="C-663") as (server, vc):
-        refused = mercmac("flash", server.path, program_file, "--backup", tmp_path / "b.mcm", *FAST)
+        refused = cli("flash", server.path, program_file, "--backup", tmp_path / "b.mcm", *FAST)
         assert refused.exit_code == 1 and "is a C-663" in refused.output and vc.md_count == 0
-        forced = mercmac("flash", server.path, program_file, "--force", "--backup",
+        forced = cli("flash", server.path, program_file, "--force", "--backup",
                          tmp_path / "b.mcm", *FAST)
     assert forced.exit_code == 0 and "flashing anyway" in forced.output
 
 
 def test_dry_run_shows_the_bytes_and_writes_nothing(program_file):
     with serve() as (server, vc):
-        result = mercmac("flash", server.path, program_file, "--dry-run", *FAST)
+        result = cli("flash", server.path, program_file, "--dry-run", *FAST)
     assert result.exit_code == 0
     assert "<01>0" in result.output and "MD5,MR5000,WS100<CR>" in result.output
     assert "TM5<CR>" in result.output and "dry run: nothing written" in result.output
@@ -98,13 +84,13 @@ def test_dry_run_shows_the_bytes_and_writes_nothing(program_file):
 
 
 def test_missing_port_exit_code_2(program_file):
-    result = mercmac("flash", "/dev/does-not-exist-mercmac", program_file, *FAST)
+    result = cli("flash", "/dev/does-not-exist-mercmac", program_file, *FAST)
     assert result.exit_code == 2 and "cannot open /dev/does-not-exist-mercmac" in result.output
 
 
 def test_lost_port_exit_code_1_with_the_state(tmp_path, program_file):
     with serve(macros={0: "EM1"}, faults=Faults(vanish_after_md=1)) as (server, vc):
-        result = mercmac("flash", server.path, program_file, "--backup", tmp_path / "b.mcm", *FAST)
+        result = cli("flash", server.path, program_file, "--backup", tmp_path / "b.mcm", *FAST)
     assert result.exit_code == 1
     assert "the port went away" in result.output and "not written: MC00" in result.output
     assert "Traceback" not in result.output
@@ -114,29 +100,29 @@ def test_pull_gives_a_file_that_checks_and_flashes_back_exactly(tmp_path):
     original = compile_source(Source("ex4", EXAMPLE4.read_text())).program
     stored = {slot: m.line for slot, m in original.macros.items()}
     with serve(macros=stored) as (server, vc):
-        pulled = mercmac("pull", server.path, "-o", tmp_path / "pulled.mcm", *FAST)
+        pulled = cli("pull", server.path, "-o", tmp_path / "pulled.mcm", *FAST)
         assert pulled.exit_code == 0, pulled.output
-        again = mercmac("flash", server.path, tmp_path / "pulled.mcm", "--backup", tmp_path / "b.mcm", *FAST)
+        again = cli("flash", server.path, tmp_path / "pulled.mcm", "--backup", tmp_path / "b.mcm", *FAST)
         assert again.exit_code == 0 and "nothing to write" in again.output
     text = (tmp_path / "pulled.mcm").read_text()
     assert "controller: C-863, firmware 2.30" in text and "address 0" in text
     check = compile_source(Source("pulled.mcm", text))
     assert not check.report.has_errors
     with serve() as (server, fresh):
-        result = mercmac("flash", server.path, tmp_path / "pulled.mcm", "--backup", tmp_path / "c.mcm", *FAST)
+        result = cli("flash", server.path, tmp_path / "pulled.mcm", "--backup", tmp_path / "c.mcm", *FAST)
         assert result.exit_code == 0
     assert fresh.macros == vc.macros
 
 
 def test_pull_to_standard_output(tmp_path):
     with serve(macros={4: "XN1,MR5"}) as (server, vc):
-        result = mercmac("pull", server.path, *FAST)
+        result = cli("pull", server.path, *FAST)
     assert result.exit_code == 0 and "[MC04] XN1,MR5\n" in result.output
 
 
 def test_scan_lists_who_answers(tmp_path):
     with serve(address=11, macros={2: "TP"}) as (server, vc):
-        result = mercmac("scan", server.path, "--timeout", "0.05")
+        result = cli("scan", server.path, "--timeout", "0.05")
     assert result.exit_code == 0, result.output
     row = [line for line in result.output.splitlines() if line.startswith("11 ")]
     assert row and "C-863" in row[0] and "2.30" in row[0]
@@ -144,14 +130,14 @@ def test_scan_lists_who_answers(tmp_path):
 
 def test_scan_leaves_a_running_macro_alone(tmp_path):
     with serve(address=4, macros={0: "SC4,WA10,RP"}) as (server, vc):
-        result = mercmac("scan", server.path, "--timeout", "0.05")
+        result = cli("scan", server.path, "--timeout", "0.05")
         assert server.call(lambda v: v.running)
     assert "macro running, left alone" in result.output
 
 
 def test_scan_of_silence_exits_1():
     with serve(faults=Faults(silent=True)) as (server, vc):
-        result = mercmac("scan", server.path, "--timeout", "0.05")
+        result = cli("scan", server.path, "--timeout", "0.05")
     assert result.exit_code == 1 and "no controller answered" in result.output
 
 
@@ -163,7 +149,7 @@ def test_ports_marks_pi_devices():
 
     lines = ports_lines([PortInfo("/dev/ttyUSB0", "Mercury", 0x1A72, 0x1007, "X")])
     assert "likely Mercury (C-863)" in "".join(t for t, _ in lines[1])
-    assert mercmac("ports").exit_code == 0
+    assert cli("ports").exit_code == 0
 
 
 @pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs pseudo-terminals")
@@ -176,11 +162,11 @@ def test_emulate_serves_a_pty_and_keeps_its_state(tmp_path, program_file):
             assert "virtual C-863" in proc.stdout.readline()
             path = proc.stdout.readline().strip()
             if round_ == 0:
-                result = mercmac("flash", path, program_file, "--address", "12", "--backup",
+                result = cli("flash", path, program_file, "--address", "12", "--backup",
                                  tmp_path / "b.mcm", *FAST)
                 assert result.exit_code == 0, result.output
             else:
-                result = mercmac("pull", path, "--address", "12", *FAST)
+                result = cli("pull", path, "--address", "12", *FAST)
                 assert "[MC00] EM5" in result.output and "[MC05] MR5000,WS100" in result.output
         finally:
             proc.send_signal(signal.SIGINT)

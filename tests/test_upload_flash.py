@@ -3,20 +3,15 @@ from __future__ import annotations
 
 import pytest
 
+from conftest import program_of
+from mercmac import mdtext
 from mercmac.compiler import compile_file, compile_source
 from mercmac.source import Source
-from mercmac.upload import protocol
 from mercmac.emulator.virtual import Faults
 from mercmac.upload.flasher import FlashOptions, flash
 from mercmac.upload.plan import Fate
 from mercmac.upload.connect import identify
 from test_upload_emulator import EXAMPLE4, connect, eventually, serve
-
-
-def program_of(text: str):
-    result = compile_source(Source("test.mcm", text))
-    assert not result.report.has_errors
-    return result.program
 
 
 def run_flash(server, program, tmp_path, address=0, **options):
@@ -28,8 +23,8 @@ def run_flash(server, program, tmp_path, address=0, **options):
 
 
 def stored_equals(vc, program) -> bool:
-    return {s: protocol.canonical(t) for s, t in vc.macros.items()} == \
-        {s: protocol.canonical(m.line) for s, m in program.macros.items()}
+    return {s: mdtext.canonical(t) for s, t in vc.macros.items()} == \
+        {s: mdtext.canonical(m.line) for s, m in program.macros.items()}
 
 
 def test_example_4_to_an_empty_controller_then_again_unchanged(tmp_path):

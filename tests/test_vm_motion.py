@@ -123,11 +123,14 @@ def test_st_overshoots_and_moves_back():
 
 def test_servo_off_refuses_moves_with_error_0a():
     events = []
-    m = Machine(Program({}), options=Options(servo_on=False), on_event=events.append)
+    said = []
+    m = Machine(Program({}), options=Options(servo_on=False), on_event=events.append,
+                on_report=lambda t, text: said.append(text))
     m.power_on()
     m.execute_line([Op("MR", 100), Op("TS")])
     m.run_until(10)
-    assert m.target == 0 and m.status().endswith(" 0A")
+    assert m.target == 0 and said[-1].endswith(" 0A")
+    assert m.status().endswith(" 00")  # the TS that read the code cleared it
     assert [e.rule for e in events if type(e).__name__ == "HazardFound"] == ["move-servo-off"]
     m.execute_line([Op("MN"), Op("MR", 100), Op("WS", 0)])
     m.run_until(100)
@@ -151,12 +154,14 @@ def test_joystick_on_refuses_moves_and_drives_with_input_5():
 
 def test_hard_limit_stops_abruptly_with_error_07():
     events = []
-    m = Machine(Program({}), options=Options(hard_limits=(-1000, 5000)), on_event=events.append)
+    said = []
+    m = Machine(Program({}), options=Options(hard_limits=(-1000, 5000)), on_event=events.append,
+                on_report=lambda t, text: said.append(text))
     m.power_on()
     m.execute_line([Op("MR", 20_000), Op("WS", 0), Op("TS")])
     m.run_until(2000)
     assert m.position() == 5000 == m.target
-    assert m.status().endswith(" 07")
+    assert said[-1].endswith(" 07")  # read by the TS, which clears it (Machine.read_status)
     hit = next(e for e in events if type(e).__name__ == "HazardFound")
     assert hit.rule == "hard-limit" and hit.where.ip == 0  # blamed on the MR that ran into it
 

@@ -198,8 +198,9 @@ def test_report_formats():
 
 def test_c663_status_has_three_blocks_and_its_defaults():
     result = run("target C-663\nautostart { TY, TL, TS }\n")
-    # block 1: on target, macro running (so not ready), brake on (BN, §3.4.2)
-    assert texts(result) == ["Y:+0000020000", "L:+0000250000", "S:52 00 00"]
+    # block 1: on target, macro running (so not ready), brake on (BN, §3.4.2); block 2: both
+    # limit lines high, as active-low switches (LL) that are not hit read (§6.4 TS `s:03 07 00`)
+    assert texts(result) == ["Y:+0000020000", "L:+0000250000", "S:52 05 00"]
 
 
 # -- Power-on ------------------------------------------------------------------

@@ -107,9 +107,7 @@ def _check_one(source, target: str | None):
         except Exception:  # an exception whose text cannot be made
             detail = type(e).__name__
         detail = detail if len(detail) <= 200 else detail[:200] + "..."
-        report.add("syntax", Span(1, 1, 1, 2),
-                   f"internal error while checking this file ({detail}); it was not fully "
-                   "checked - please report this with the file")
+        report.add("syntax", Span(1, 1, 1, 2), "internal", detail=detail)
         return Compilation(source, report, None)
 
 

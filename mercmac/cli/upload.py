@@ -52,24 +52,16 @@ def flash(port, file, address, baud, dry_run, backup, erase_unused, reset, force
 
         from mercmac.render import upload as view
         from mercmac.render.console import write_lines
-        from mercmac.upload import connect, flasher
-        from mercmac.upload.errors import FlashInterrupted
+        from mercmac.upload import backup as backups
+        from mercmac.upload import flasher
 
-        program = _compile(file, target)
-        if backup:
-            _check_output(Path(backup))  # a device, FIFO or folder: refused before the port opens
         options = flasher.FlashOptions(erase_unused, dry_run, reset, Path(backup) if backup else None)
-        with connect.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
-            try:
-                who = connect.identify(c)
-                if program.target is None:
-                    program = _compile(file, who.version.model)
-                warning = connect.check_model(who, program.target, file, force=force)
-                write_lines(view.identity_lines(port, address, who, warning))
-            except KeyboardInterrupt:
-                raise FlashInterrupted("interrupted before the first write; nothing was written") from None
-            with view.FlashProgress() as progress:
-                result = finished[0] = flasher.flash(c, who, program, options, progress)
+        try:
+            result = flasher.flash_file(port, file, address=address, baud=baud,
+                                        timing=_timing(timeout), options=options, target=target,
+                                        force=force, watch=_watch(port, address, finished))
+        except backups.BackupError as e:
+            raise _unwritable(e) from None
         if dry_run:
             write_lines(view.dry_run_lines(result, address, baud))
         write_lines(view.flash_summary(result, port))
@@ -93,17 +85,31 @@ def _reporting_completion(work, finished) -> int:
             from None
 
 
-def _compile(file: str, target: str | None):
-    """The program of FILE, or a refusal with its diagnostics on standard error."""
-    from mercmac.compiler import compile_file
-    from mercmac.render import report as render
-    from mercmac.upload.errors import Refused
+def _watch(port: str, address: int, finished: list):
+    """What `flash` shows while flashing: diagnostics, who answered, a progress bar."""
+    from contextlib import contextmanager
 
-    result = compile_file(file, target=target)
-    if render.write_errors(result):
-        against = f" for the {target}" if target else ""
-        raise Refused(f"{file} has errors{against}; nothing was flashed")
-    return result.program
+    from mercmac.render import report as render
+    from mercmac.render import upload as view
+    from mercmac.render.console import write_lines
+    from mercmac.upload import flasher
+
+    class Shown(flasher.Watch):
+        def refused(self, compilation) -> None:
+            render.write_errors(compilation)  # on standard error, before the refusal
+
+        def identified(self, identity, warning) -> None:
+            write_lines(view.identity_lines(port, address, identity, warning))
+
+        @contextmanager
+        def writing(self):
+            with view.FlashProgress() as progress:
+                yield progress
+
+        def finished(self, result) -> None:
+            finished[0] = result  # a Ctrl-C from here on still says what was done
+
+    return Shown()
 
 
 @click.command()
@@ -153,7 +159,12 @@ def _check_output(path) -> None:
     try:
         backup.check(path)
     except backup.BackupError as e:
-        raise UsageError(str(e), hint="give the path of a file to create or replace") from None
+        raise _unwritable(e) from None
+
+
+def _unwritable(e: Exception) -> UsageError:
+    """An output path that cannot be written (exit 2)."""
+    return UsageError(str(e), hint="give the path of a file to create or replace")
 
 
 @click.command()
@@ -207,33 +218,48 @@ def scan(port, baud, timeout, stop) -> None:
               show_default=True, help="How a TM listing ends its lines (SPEC §4 allows both).")
 @click.option("--empty-slot", type=click.Choice(["empty", "bare"]), default="empty",
               show_default=True, help="TMn of an empty slot: an empty report or a bare MCnnn.")
-def emulate(target, address, state, firmware, tm_framing, empty_slot) -> None:
+@click.option("--log", "log_file", type=click.Path(dir_okay=False),
+              help="Add every byte both ways to this file, timestamped, as it passes.")
+@click.option("--pace", is_flag=True,
+              help="Pace the link like real hardware: bytes at --baud, firmware 1.xx's 20 ms "
+                   "character gap, characters lost while a move runs.")
+@click.option("--baud", type=click.IntRange(300, 921_600), default=9600, show_default=True,
+              help="Baud rate the link is paced at (with --pace).")
+def emulate(target, address, state, firmware, tm_framing, empty_slot, log_file, pace,
+            baud) -> None:
     """Serve a virtual controller on a pseudo-terminal and print the path to open.
 
     Try `mercmac flash PATH FILE` without hardware; Ctrl-C stops it.
     """
     def work() -> int:
+        from contextlib import nullcontext
         from pathlib import Path
 
         from mercmac.emulator.virtual import Faults, VirtualController
         from mercmac.emulator.ptyserver import PtyServer
+        from mercmac.outfile import appending
 
+        faults = Faults(tm_framing=tm_framing, empty_slot=empty_slot, pace=pace, baud=baud)
         vc = VirtualController(target.upper(), address, firmware=firmware,
-                               state=Path(state) if state else None,
-                               faults=Faults(tm_framing=tm_framing, empty_slot=empty_slot))
-        try:
-            server = PtyServer(vc)
-        except OSError as e:
-            raise UsageError(f"cannot create a pseudo-terminal: {e}") from None
-        kept = f", macros kept in {state}" if state else ""
-        click.echo(f"virtual {vc.model} (firmware {firmware}) at address {address}{kept}")
-        click.echo(server.path)
-        try:
-            server.serve_forever()
-        except KeyboardInterrupt:
-            pass
-        finally:
-            server.close()
+                               state=Path(state) if state else None, faults=faults)
+        # a device, FIFO or folder is refused here, before the pseudo-terminal exists
+        with appending(log_file) if log_file else nullcontext() as log:
+            try:
+                server = PtyServer(vc, log)
+            except OSError as e:
+                raise UsageError(f"cannot create a pseudo-terminal: {e}") from None
+            kept = f", macros kept in {state}" if state else ""
+            paced = f", paced at {baud} baud" if pace else ""
+            logged = f", bytes logged to {log_file}" if log_file else ""
+            click.echo(f"virtual {vc.model} (firmware {firmware}) at address {address}"
+                       f"{kept}{paced}{logged}")
+            click.echo(server.path)
+            try:
+                server.serve_forever()
+            except KeyboardInterrupt:
+                pass
+            finally:
+                server.close()
         return EXIT_OK
 
     run_guarded(work)

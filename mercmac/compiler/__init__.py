@@ -27,14 +27,15 @@ def compile_source(source: Source, target: str | None = None) -> Compilation:
     from mercmac.compiler.checks import check_module
     from mercmac.compiler.program_checks import check_program
     from mercmac.compiler.lower import lower
-    from mercmac.compiler.parse import parse
+    from mercmac.compiler.parse import parse, paused_gc
 
     report = Report(source.name)
     tree = parse(source.text, report)
     if tree is None:
         return Compilation(source, report, None)
     module = build(tree)
-    env = check_module(module, report, target.upper() if target else None)
+    with paused_gc():  # a diagnostic per command of a 1 MB file makes no cycles either
+        env = check_module(module, report, target.upper() if target else None)
     program = lower(module, env, report, source.name)
     check_program(program, report)
     return Compilation(source, report, program)

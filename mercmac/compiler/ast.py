@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import NamedTuple, Union
 
+from mercmac.mdtext import MAX_DIGITS
 from mercmac.source import Span
 
 
@@ -21,18 +22,17 @@ class Name(NamedTuple):
 
 
 class Invalid(NamedTuple):
-    """A number that cannot be used (too many digits, not whole milliseconds): the rule
-    and message to report where it is used."""
+    """A number that cannot be used (too many digits, not whole milliseconds): the rule,
+    its message variant and the values to report where it is used."""
 
     rule: str
-    message: str
+    variant: str
+    values: tuple  # ((field, value), ...): hashable, as the AST is
     span: Span
     value = None  # as a pin or a count it is no slot and no number
 
 
-# Longer numbers are outside every range of MS176E §6.4, and int() refuses more than
-# 4,300 digits; such a literal becomes an Invalid (a slot number: TOO_BIG).
-MAX_DIGITS = 18
+# A literal of more than mdtext.MAX_DIGITS digits becomes an Invalid (a slot number: TOO_BIG).
 TOO_BIG = 10 ** MAX_DIGITS
 
 Value = Union[Number, Name, Invalid]

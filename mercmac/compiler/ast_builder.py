@@ -1,6 +1,7 @@
 """Parse tree -> AST. The Transformer builds dataclasses with spans and nothing else."""
 from __future__ import annotations
 
+from mercmac import mdtext
 from mercmac.compiler import ast
 from mercmac.compiler.parser_tables import Token, Transformer, v_args
 from mercmac.source import Span
@@ -14,19 +15,11 @@ def _tspan(tok: Token) -> Span:
     return Span(tok.line, tok.column, tok.end_line, tok.end_column)
 
 
-def _int(text: str) -> int | None:
-    """The value of an INT token; None when it has more than MAX_DIGITS digits."""
-    text = text.replace(" ", "").replace("\t", "")
-    digits = text.lstrip("+-").lstrip("0")
-    return None if len(digits) > ast.MAX_DIGITS else int(text)
-
-
 def _number(tok: Token) -> ast.Number | ast.Invalid:
-    value = _int(tok.value)
+    value = mdtext.number(tok.value)  # None: more than MAX_DIGITS digits
     if value is None:
         digits = len(tok.value.lstrip("+- \t0"))
-        return ast.Invalid("argument-range", f"a number of {digits:,} digits is out of every range "
-                           "(no argument of the controller has more than 10)", _tspan(tok))
+        return ast.Invalid("argument-range", "digits", (("digits", digits),), _tspan(tok))
     return ast.Number(value, _tspan(tok))
 
 
@@ -41,10 +34,12 @@ class _Build(Transformer):
         return ast.Module(tuple(items))
 
     def raw_block(self, meta, children):
-        header, *commands = children
-        digits = header.value.upper().strip("[] \t")[2:]  # "[ MC 05 ]" -> " 05 "
-        slot = _int(digits)
-        return ast.RawBlock(ast.TOO_BIG if slot is None else slot, tuple(commands), _tspan(header))
+        tok = children[0]
+        raw = tok.value  # parse.RawLine: the commands as mercmac.mdtext read them
+        header = Span(tok.line, tok.column, tok.line, tok.column + raw.header)
+        at = tok.column + raw.header
+        commands = tuple(_raw_command(c, tok.line, at) for c in raw.commands)
+        return ast.RawBlock(ast.TOO_BIG if raw.slot is None else raw.slot, commands, header)
 
     def target(self, meta, children):
         model = children[0].value.upper()
@@ -98,13 +93,26 @@ class _Build(Transformer):
         try:
             return ast.Number(parse_duration(tok.value), _tspan(tok))
         except (ValueError, OverflowError) as e:  # TimeSpecError is a ValueError
-            return ast.Invalid("bad-argument", f"every takes a whole number of milliseconds: {e}",
-                               _tspan(tok))
+            return ast.Invalid("bad-argument", "duration", (("error", str(e)),), _tspan(tok))
 
     def command(self, meta, children):
         word = children[0]
         value = _value(children[1]) if len(children) > 1 else None
         return ast.Command(word.value, value, _span(meta), _tspan(word))
+
+
+def _raw_command(c: mdtext.Written, line: int, at: int) -> ast.Command:
+    """One command of a raw block, its columns counted from `at` (where the commands start)."""
+    span = Span(line, at + c.start, line, at + c.end)
+    value_span = Span(line, at + c.value_start, line, at + c.end)
+    value = c.value
+    if isinstance(value, int):
+        value = ast.Number(value, value_span)
+    elif isinstance(value, mdtext.TooLong):
+        value = ast.Invalid("argument-range", "digits", (("digits", value.digits),), value_span)
+    elif value is not None:
+        value = ast.Name(value, value_span)
+    return ast.Command(c.word, value, span, Span(line, at + c.start, line, at + c.word_end))
 
 
 def _value(tok: Token) -> ast.Value:

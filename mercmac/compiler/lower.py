@@ -21,8 +21,8 @@ from typing import NamedTuple
 
 from mercmac.compiler import ast
 from mercmac.compiler.checks import Env
-from mercmac.compiler.program import (MAX_COMMANDS, SLOTS, Macro, Op, Program, rp_counts,
-                                      wait_pieces)
+from mercmac.compiler.program import (MAX_COMMANDS, SLOTS, Macro, Op, Origin, Program, Role,
+                                      rp_counts, wait_pieces)
 from mercmac.diagnostics import Report
 from mercmac.source import Span
 
@@ -32,7 +32,7 @@ class _Macro:
 
     __slots__ = ("name", "origin", "span", "slot", "ops")
 
-    def __init__(self, name: str, origin: str, span: Span, slot: int | None = None):
+    def __init__(self, name: str, origin: Origin, span: Span, slot: int | None = None):
         self.name, self.origin, self.span, self.slot = name, origin, span, slot
         self.ops: list = []  # Op, or _Em before allocation
 
@@ -42,7 +42,7 @@ class _Em(NamedTuple):
 
     target: _Macro
     span: Span
-    role: str
+    role: Role
 
 
 def _calls_on(ops: list) -> bool:
@@ -50,10 +50,10 @@ def _calls_on(ops: list) -> bool:
     other than through a goto (after an inner call, an XN/XF exit ends the program).
     A block chained into parts is read as the one line it stands for."""
     ops = _unchained(ops)
-    calls = [i for i, op in enumerate(ops) if _is_em(op) and op.role != "goto"]
+    calls = [i for i, op in enumerate(ops) if _is_em(op) and op.role is not Role.GOTO]
     if not calls:
         return False
-    ends_in_goto = _is_em(ops[-1]) and ops[-1].role == "goto"
+    ends_in_goto = _is_em(ops[-1]) and ops[-1].role is Role.GOTO
     exits_after = any(isinstance(op, Op) and op.mnemonic in ("XN", "XF") for op in ops[calls[0]:])
     return exits_after or not ends_in_goto
 
@@ -61,7 +61,7 @@ def _calls_on(ops: list) -> bool:
 def _unchained(ops: list) -> list:
     """A line with its chained parts (tail EMs 'continue' to a part) read back as one."""
     last = ops[-1] if ops else None
-    if isinstance(last, _Em) and last.role == "continue" and last.target.origin == "part":
+    if isinstance(last, _Em) and last.role is Role.CONTINUE and last.target.origin is Origin.PART:
         return ops + _unchained(last.target.ops)  # the tail EM stays: it is a call too
     return ops
 
@@ -81,7 +81,7 @@ class _Lowerer:
         self.warned: set = set()
         self.inlined: set[str] = set()
 
-    def new(self, name: str, origin: str, span: Span, slot: int | None = None) -> _Macro:
+    def new(self, name: str, origin: Origin, span: Span, slot: int | None = None) -> _Macro:
         m = _Macro(name, origin, span, slot)
         self.order.append(m)
         return m
@@ -91,7 +91,7 @@ class _Lowerer:
         name = f"{owner.name}.{kind}@{span.line}"
         if any(m.name == name for m in self.order):  # two blocks on one line
             name += f":{span.column}"
-        return self.new(name, kind, span)
+        return self.new(name, Origin(kind), span)
 
     # -- statements --------------------------------------------------------
     def seq(self, stmts: tuple, owner: _Macro, *, at_start: bool, loop: bool,
@@ -114,7 +114,7 @@ class _Lowerer:
             elif isinstance(stmt, ast.Goto):
                 target = self.named.get(stmt.name)
                 if target is not None:
-                    out.append(_Em(target, stmt.span, "goto"))
+                    out.append(_Em(target, stmt.span, Role.GOTO))
                 return out  # a goto transfers for good: nothing after it runs
             elif isinstance(stmt, ast.Call):
                 if (rest or cont is not None or loop) and self.inline(stmt):
@@ -123,7 +123,7 @@ class _Lowerer:
                     return out + self.seq(self.env.macros[stmt.name].body + rest, **again)
                 target = self.named.get(stmt.name)
                 if target is not None:
-                    out.append(_Em(target, stmt.span, "call"))
+                    out.append(_Em(target, stmt.span, Role.CALL))
             elif isinstance(stmt, ast.Repeat) and self.count(stmt) == 0:
                 continue  # `repeat 0` runs nothing (reported as info)
             elif isinstance(stmt, (ast.Repeat, ast.Every)) and self.once(stmt):
@@ -140,7 +140,7 @@ class _Lowerer:
                 out += self.loop_ops(stmt, owner, leaf)
             else:
                 block = self.helper(owner, type(stmt).__name__.lower(), stmt.span)
-                out.append(_Em(block, stmt.span, "hoist"))
+                out.append(_Em(block, stmt.span, Role.HOIST))
                 mark = len(self.order)
                 block.ops = self.block_ops(stmt, block, None, loop or leaf)
                 if (rest or cont) and not loop and _calls_on(block.ops):
@@ -161,11 +161,7 @@ class _Lowerer:
         if op.mnemonic == "TI" and self.loops and self.loops[-1] is not owner \
                 and op.span not in self.warned:
             self.warned.add(op.span)
-            self.report.add("ti-moved", op.span,
-                            f"this TI runs in '{owner.name}', a macro of its own, not in "
-                            f"'{self.loops[-1].name}' with the RP of its loop: it reports "
-                            f"the counter of '{owner.name}' (0), not the loop's remaining "
-                            "count (each macro has its own RP counters)")
+            self.report.add("ti-moved", op.span, owner=owner.name, loop=self.loops[-1].name)
         return op
 
     def block_ops(self, stmt, block: _Macro, cont: _Macro | None, leaf: bool) -> list:
@@ -228,13 +224,13 @@ class _Lowerer:
         for item in module.items:
             if isinstance(item, ast.MacroDef) and self.env.macros.get(item.name) is item:
                 pin = item.pin.value if item.pin is not None and item.pin.value in SLOTS else None
-                self.named[item.name] = self.new(item.name, "macro", item.span, pin)
+                self.named[item.name] = self.new(item.name, Origin.MACRO, item.span, pin)
         for item in module.items:
             if isinstance(item, ast.RawBlock):
-                m = self.new(f"MC{item.slot:02d}", "raw", item.span, item.slot)
+                m = self.new(f"MC{item.slot:02d}", Origin.RAW, item.span, item.slot)
                 m.ops = [self.env.ops[c] for c in item.commands if c in self.env.ops]
             elif isinstance(item, ast.Autostart):
-                m = self.new("autostart", "autostart", item.span, 0)
+                m = self.new("autostart", Origin.AUTOSTART, item.span, 0)
                 m.ops = self.seq(item.body, m, at_start=True, loop=False) or _nothing(item.span)
             elif isinstance(item, ast.MacroDef) and item.name in self.named:
                 m = self.named[item.name]
@@ -243,7 +239,7 @@ class _Lowerer:
 
     def calling(self) -> set[str]:
         """The named macros whose lowered line calls on (contains an EM)."""
-        return {m.name for m in self.order if m.origin == "macro" and any(map(_is_em, m.ops))}
+        return {m.name for m in self.order if m.origin is Origin.MACRO and any(map(_is_em, m.ops))}
 
     def split(self) -> None:
         """Fit every lowered macro into 16 commands (MS176E §3.8) where the meaning allows."""
@@ -255,24 +251,21 @@ class _Lowerer:
         part up to it stays on the line (RP repeats from the start) and moves runs of
         plain commands into macros it calls: those call nothing, so it keeps its
         return point."""
-        while m.origin != "raw" and len(m.ops) > MAX_COMMANDS:
+        while m.origin is not Origin.RAW and len(m.ops) > MAX_COMMANDS:
             last = max((i for i, op in enumerate(m.ops) if _is_op(op, "RP")), default=-1)
             if last + 1 < MAX_COMMANDS:
                 self.chain(m)
                 return
             runs = _movable_runs(m.ops[:last])
             if not runs:
-                self.report.add("too-many-commands", m.span,
-                                f"'{m.name}' needs {len(m.ops)} commands and a macro holds "
-                                f"{MAX_COMMANDS}. It cannot be split: its RP repeats the whole "
-                                "line, and what it holds cannot move into a called macro "
-                                "(calls, conditions, TI). Move part of it into a macro of its own")
+                self.report.add("too-many-commands", m.span, "unsplittable", macro=f"'{m.name}'",
+                                count=len(m.ops), max=MAX_COMMANDS)
                 return
             start, end = max(runs, key=lambda r: r[1] - r[0])
             end = start + min(end - start, len(m.ops) - MAX_COMMANDS + 1, MAX_COMMANDS)
-            part = self.new(self.part_name(m), "part", m.span)
+            part = self.new(self.part_name(m), Origin.PART, m.span)
             part.ops = m.ops[start:end]
-            m.ops[start:end] = [_Em(part, _span_of(part.ops[0], m.span), "hoist")]
+            m.ops[start:end] = [_Em(part, _span_of(part.ops[0], m.span), Role.HOIST)]
 
     def part_name(self, m: _Macro) -> str:
         """'jog.part2', 'jog.part3', ...: the next free part name of a split macro."""
@@ -285,10 +278,10 @@ class _Lowerer:
     def chain(self, m: _Macro) -> None:
         part = m
         while len(part.ops) > MAX_COMMANDS:
-            tail = self.new(self.part_name(m), "part", m.span)
+            tail = self.new(self.part_name(m), Origin.PART, m.span)
             keep = MAX_COMMANDS - 1
             tail.ops, part.ops = part.ops[keep:], part.ops[:keep]
-            part.ops.append(_Em(tail, _span_of(tail.ops[0], m.span), "continue"))
+            part.ops.append(_Em(tail, _span_of(tail.ops[0], m.span), Role.CONTINUE))
             part = tail
 
     def allocate(self) -> dict[int, _Macro]:
@@ -302,9 +295,8 @@ class _Lowerer:
             if m.slot is None:
                 m.slot = next(free, None)
                 if m.slot is None:
-                    self.report.add("slot-range", m.span,
-                                    f"no free slot for '{m.name}': the program needs "
-                                    f"{len(self.order)} macros and the controller holds 32")
+                    self.report.add("slot-range", m.span, "full", name=m.name,
+                                    count=len(self.order))
                     continue
                 taken[m.slot] = m
         return taken
@@ -354,7 +346,7 @@ def _has_ti(body: tuple) -> bool:
 
 
 def _tail(cont: _Macro | None, span: Span) -> list:
-    return [] if cont is None else [_Em(cont, span, "continue")]
+    return [] if cont is None else [_Em(cont, span, Role.CONTINUE)]
 
 
 def _span_of(op, default: Span) -> Span:

@@ -12,7 +12,9 @@ from __future__ import annotations
 import contextlib
 import gc
 import re
+from typing import NamedTuple
 
+from mercmac import mdtext
 from mercmac.commands import lookup
 from mercmac.compiler import parser_tables as lark
 from mercmac.diagnostics import Report
@@ -34,18 +36,16 @@ _TERMINALS = {
     "REPEAT": "'repeat'", "EVERY": "'every'", "CALL": "'call'", "GOTO": "'goto'",
 }
 
-# Named errors (lark's match_examples): a label and snippets that fail the same way.
+# Named errors (lark's match_examples): the `syntax` message variant (its wording is in
+# mercmac.diagnostics) and snippets that fail the same way.
 _EXAMPLES = {
-    "commands are separated by commas": [
-        "[MC01] MR5000 WS100\n", "[MC01] TP TT\n", "macro a { MR5000 WS100 }\n",
-        "macro a { TP TT }\n",
-    ],
-    "a command must stand in a [MCnn] block or in a macro/autostart block": [
+    "comma": ["macro a { MR5000 WS100 }\n", "macro a { TP TT }\n"],  # raw lines: mdtext
+    "outside": [
         "MR5000\n", "TP\n", "macro a { }\nTP\n", "[MC01] TP\nTP\n", "target C-863\nTP\n",
         "const A = 1\nTP\n",
     ],
-    "a block needs its closing '}'": ["macro a {\nTP\n", "autostart { TP\n"],
-    "'macro' needs a name, an optional @slot and a block: macro NAME @5 { ... }": [
+    "brace": ["macro a {\nTP\n", "autostart { TP\n"],
+    "macro-header": [
         "macro { }\n", "macro 5 { }\n", "macro a 5 { }\n", "macro a @ { }\n",
     ],
 }
@@ -69,24 +69,52 @@ def parser():
     """The stand-alone LALR parser, built once per process."""
     global _PARSER
     if _PARSER is None:
-        _PARSER = lark.Lark_StandAlone()
+        _PARSER = lark.Lark_StandAlone(lexer_callbacks={"RAW_LINE": _raw_line})
     return _PARSER
+
+
+class RawLine(NamedTuple):
+    """A `[MCnn] ...` line read by mdtext: the value of its RAW_LINE token."""
+
+    slot: int | None  # None: more than MAX_DIGITS digits
+    header: int  # length of `[MCnn]`: the commands start there
+    commands: list[mdtext.Written]
+    problems: list[mdtext.Problem]
+
+
+_HEADER = re.compile(r"\[[ \t]*MC([^\]]*)\]", re.IGNORECASE)
+_ACTIVE: list = []  # the _Recovery of the parse under way
+
+
+def _raw_line(token):
+    """Read a raw block's commands as the controller reads a stored line (mercmac.mdtext);
+    its syntax errors are the parser's (one per line, and the file is not checked further)."""
+    text = str(token)
+    header = _HEADER.match(text)
+    body = text[header.end():].split("//", 1)[0]  # a comment may end the line
+    commands, problems = mdtext.lex(body)
+    token.value = RawLine(mdtext.number(header.group(1)), header.end(), commands, problems)
+    if problems and _ACTIVE and _ACTIVE[-1]:
+        _ACTIVE[-1].raw_error(token, problems[0])
+    return token
 
 
 def parse(text: str, report: Report):
     """The parse tree of `text`, or None after reporting every syntax error."""
     nul = text.find("\x00")
     if nul >= 0:
-        report.add("syntax", _span_at(text, nul),
-                   "the file holds NUL characters: it looks like a binary file, not .mcm text "
-                   "(UTF-8, Windows-1252, or UTF-16 with a byte-order mark)")
+        report.add("syntax", _span_at(text, nul), "binary")
         return None
     recovery = _Recovery(report)
+    _ACTIVE.append(recovery)
     try:
         with paused_gc():
             tree = parser().parse(text + "\n", on_error=recovery)
     except lark.UnexpectedInput:  # reported; recovery stopped at the end of the file
         return None
+    finally:
+        _ACTIVE.pop()
+        recovery.flush()
     if recovery.failed:
         return None
     if text.count("{") > MAX_NESTING:
@@ -107,6 +135,24 @@ class _Recovery:
         self.report = report
         self.failed = False
         self.last: tuple[int, int] | None = None  # (line, position) of the last error
+        self.first = len(report.items)
+        self.raw: dict[int, tuple] = {}  # line -> a raw block's syntax error, reported at the end
+
+    def raw_error(self, token, problem) -> None:
+        """A syntax error in a raw block's commands: kept unless the parser fails on its line."""
+        self.failed = True
+        column = token.column + token.value.header
+        span = Span(token.line, column + problem.start, token.line, column + problem.end)
+        self.raw[token.line] = (span, problem.variant, dict(problem.values))
+
+    def flush(self) -> None:
+        """Report the raw blocks' errors among the parser's, in line order."""
+        if not self.raw:
+            return
+        for line, (span, variant, values) in self.raw.items():
+            self.report.add("syntax", span, variant, **values)
+        self.report.items[self.first:] = sorted(self.report.items[self.first:],
+                                                key=lambda d: d.span.line)
 
     def __call__(self, e) -> bool:
         self.failed = True
@@ -115,8 +161,10 @@ class _Recovery:
         line = _error_line(e, text)
         if (line, position) == self.last:  # no progress: give up rather than loop
             return False
+        self.raw.pop(line, None)  # one error per line: the parser's
         if self.last is None or self.last[0] != line or _at_end(e):  # one error per line
-            self.report.add("syntax", _error_span(e, line), _message(e, line, _before(e, text)))
+            variant, values = _message(e, line, _before(e, text))
+            self.report.add("syntax", _error_span(e, line), variant, **values)
         self.last = (line, position)
         if _at_end(e):
             return False
@@ -190,8 +238,7 @@ def _limit_nesting(tree, report: Report) -> None:
             if level > MAX_NESTING:
                 line, column = child.meta.line, child.meta.column
                 report.add("slot-range", Span(line, column, line, column + len(child.data)),
-                           f"blocks nested more than {MAX_NESTING} deep cannot fit the controller "
-                           "(32 macros of 16 commands): move inner blocks into macros of their own")
+                           "nesting", depth=MAX_NESTING)
                 child.children[-1].children = []
             else:
                 stack.append((child, level))
@@ -224,26 +271,27 @@ def _before(e, text: str, limit: int = 80) -> str:
     return text[start:position]
 
 
-def _message(e, line: int, before: str) -> str:
+def _message(e, line: int, before: str) -> tuple[str, dict]:
+    """The `syntax` message variant for this error and the values it names."""
     label = _label(e)
     if label:
-        return label
+        return label, {}
     found = _found(e)
     if isinstance(e, lark.UnexpectedCharacters) and not e.char.isascii():
-        return (f"unexpected {found}: names and commands are ASCII letters, digits and '_' "
-                "(arguments are ASCII digits)")
+        return "ascii", {"found": found}
     if found == "'.'" and before[-1:].isdigit():
-        return "arguments are whole numbers (counts, steps, ms); there is no decimal point"
+        return "decimal", {}
     m = _MNEMONIC_BEFORE.search(before)
     command = lookup(m.group(1)) if m else None
     if command is not None and (isinstance(e, lark.UnexpectedCharacters) or found != "end of line"):
-        return f"{command.expects()}, found {found}"
+        return "argument", {"expects": command.expects(), "found": found}
     expected = _expected(e)
-    return f"unexpected {found}" + (f"; expected {expected}" if expected else "")
+    return ("expected", {"found": found, "expected": expected}) if expected else (
+        "unexpected", {"found": found})
 
 
 def _label(e) -> str | None:
-    """The label of an example that fails in the same parser state on the same token.
+    """The variant of an example that fails in the same parser state on the same token.
 
     Like lark's `match_examples`, but by LALR state alone: lark also compares
     stack depth, so an example would only match at the top of a file.
@@ -275,10 +323,13 @@ def _example_keys() -> dict[str, set]:
         for label, examples in _EXAMPLES.items():
             keys = _KEYS.setdefault(label, set())
             for example in examples:
+                _ACTIVE.append(None)  # not the file's errors
                 try:
                     parser().parse(example)
                 except lark.UnexpectedInput as ex:
                     keys.add(_key(ex))
+                finally:
+                    _ACTIVE.pop()
     return _KEYS
 
 

@@ -5,11 +5,13 @@ show macro names, not numbers, through `Macro.name` and the spans of `Op`.
 """
 from __future__ import annotations
 
+from enum import Enum
 from typing import NamedTuple
 
+from mercmac import mdtext
 from mercmac.source import Span
 
-MAX_COMMANDS = 16  # MS176E §3.8: "Each macro can contain up to 16 base commands"
+MAX_COMMANDS = mdtext.MAX_COMMANDS  # MS176E §3.8: "Each macro can contain up to 16 base commands"
 SLOTS = range(32)  # MS176E §3.8.4: macros 0 to 31, 0 = autostart
 MAX_RP = 32_568  # MS176E §6.4 RP: n <= 32568
 MAX_WA = 65_535  # MS176E §6.4 WA: n <= 65535 ms
@@ -37,20 +39,58 @@ def wait_pieces(ms: int) -> list[int]:
     return [ms // n + (1 if i < ms % n else 0) for i in range(n)]
 
 
+class _Text(str, Enum):
+    """A closed set of names that reads, compares, prints and dumps to JSON as its text."""
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __format__(self, spec: str) -> str:
+        return format(self.value, spec)
+
+    def __hash__(self) -> int:  # equal to its text, so it hashes as its text
+        return str.__hash__(self)
+
+
+class Role(_Text):
+    """Why an EM is there."""
+
+    NONE = ""  # not an EM
+    RAW = "raw"  # written natively
+    CALL = "call"
+    GOTO = "goto"
+    HOIST = "hoist"  # a `when`, `repeat` or `every` body moved into a macro of its own
+    CONTINUE = "continue"  # the tail EM to a macro that continues a split block or the rest
+
+
+class Origin(_Text):
+    """Where a macro came from: written by the user, made by the compiler, or read back."""
+
+    RAW = "raw"  # a `[MCnn]` block
+    MACRO = "macro"
+    AUTOSTART = "autostart"
+    WHEN = "when"  # a hoisted `when` body
+    REPEAT = "repeat"
+    EVERY = "every"
+    REST = "rest"  # the code after a hoisted block that calls out
+    PART = "part"  # a piece of a block longer than 16 commands
+    STORED = "stored"  # read from a controller (the emulator's flash memory)
+
+
+USER_ORIGINS = (Origin.RAW, Origin.MACRO, Origin.AUTOSTART)  # what the user wrote
+
+
 class Op(NamedTuple):
     """One base command of a lowered macro.
 
     `mnemonic` is the key of `mercmac.commands.COMMANDS` (upper case, 'FA?'
-    for queries); `arg` is None when omitted. For EM, `role` says why it is
-    there: 'raw' (written natively), 'call', 'goto', 'hoist' (a `when`,
-    `repeat` or `every` body moved into a macro of its own), 'continue' (the
-    tail EM to a macro that continues a split block or the rest of a block).
+    for queries); `arg` is None when omitted. For EM, `role` says why it is there.
     """
 
     mnemonic: str
     arg: int | None = None
     span: Span | None = None
-    role: str = ""
+    role: Role = Role.NONE
 
     @property
     def text(self) -> str:
@@ -63,13 +103,13 @@ class Macro:
     __slots__ = ("slot", "name", "ops", "span", "origin")
 
     def __init__(self, slot: int, name: str, ops: list[Op] | None = None,
-                 span: Span | None = None, origin: str = "raw"):
+                 span: Span | None = None, origin: Origin | str = Origin.RAW):
         self.slot, self.name, self.span = slot, name, span
         self.ops: list[Op] = [] if ops is None else ops
-        self.origin = origin  # raw, macro, autostart, when, repeat, every, rest, part, stored
+        self.origin = Origin(origin)
 
     def __repr__(self) -> str:
-        return f"Macro({self.slot}, {self.name!r}, {self.line!r}, origin={self.origin!r})"
+        return f"Macro({self.slot}, {self.name!r}, {self.line!r}, origin={self.origin.value!r})"
 
     def __eq__(self, other) -> bool:
         return isinstance(other, Macro) and all(
@@ -78,12 +118,12 @@ class Macro:
     @property
     def line(self) -> str:
         """The command line as stored: 'MR5000,WS100'."""
-        return ",".join(op.text for op in self.ops)
+        return mdtext.format_ops(self.ops)
 
     @property
     def md(self) -> str:
         """The definition sent to the controller: 'MD5,MR5000,WS100' (MS176E §3.8.1)."""
-        return f"MD{self.slot},{self.line}" if self.ops else f"MD{self.slot}"  # raw `[MCnn]` only
+        return mdtext.md(self.slot, self.ops)  # a bare `MDn` for an empty raw `[MCnn]` only
 
     @property
     def label(self) -> str:

@@ -6,11 +6,10 @@ contradictory conditions, the 16-command limit and goto placement.
 """
 from __future__ import annotations
 
-from mercmac.compiler.program import MAX_COMMANDS, Macro, Op, Program
+from mercmac.compiler.program import MAX_COMMANDS, USER_ORIGINS, Macro, Op, Origin, Program, Role
 from mercmac.diagnostics import Report, Severity
 
 _CONDITIONS = ("XN", "XF")
-_USER_ORIGINS = ("raw", "macro", "autostart")
 
 
 def check_program(program: Program, report: Report) -> None:
@@ -26,23 +25,18 @@ def check_program(program: Program, report: Report) -> None:
 
 
 def _length(m: Macro, report: Report) -> None:
-    if m.origin == "raw" and len(m.ops) > MAX_COMMANDS:
-        report.add("too-many-commands", m.span,
-                   f"{m.label} holds {len(m.ops)} commands; a macro holds at most {MAX_COMMANDS} "
-                   "(MS176E §3.8)")
+    if m.origin == Origin.RAW and len(m.ops) > MAX_COMMANDS:
+        report.add("too-many-commands", m.span, macro=m.label, count=len(m.ops),
+                   max=MAX_COMMANDS)
 
 
 def _placement(m: Macro, report: Report) -> None:
     for i, op in enumerate(m.ops):
         if op.mnemonic == "SC" and m.slot != 0:
-            where = "" if m.origin in _USER_ORIGINS else f" (this block was moved into {m.label})"
-            report.add("sc-outside-autostart", op.span or m.span,
-                       f"SC is only allowed in macro 0, the autostart macro{where}")
-        if op.role == "goto" and i != len(m.ops) - 1:
-            report.add("syntax", op.span or m.span,
-                       "this goto would come back into the loop around it: goto must end its "
-                       "macro, so it cannot stand directly in a repeat or every block "
-                       "(wrap it in a when block)")
+            moved = "" if m.origin in USER_ORIGINS else "moved"
+            report.add("sc-outside-autostart", op.span or m.span, moved, macro=m.label)
+        if op.role == Role.GOTO and i != len(m.ops) - 1:
+            report.add("goto-not-last", op.span or m.span, "loop")
 
 
 def _contradictions(m: Macro, report: Report) -> None:
@@ -52,9 +46,8 @@ def _contradictions(m: Macro, report: Report) -> None:
             continue
         other = seen.get(("XF" if op.mnemonic == "XN" else "XN", op.arg))
         if other is not None:
-            report.add("contradictory-condition", op.span or m.span,
-                       f"{m.label} tests input {op.arg} with both {other.text} and {op.text}: "
-                       "the rest can only run if the input changed in between")
+            report.add("contradictory-condition", op.span or m.span, macro=m.label,
+                       input=op.arg, first=other.text, second=op.text)
         seen.setdefault((op.mnemonic, op.arg), op)
 
 
@@ -63,36 +56,26 @@ def _call(program: Program, caller: Macro, index: int, op: Op, report: Report) -
         return  # its target got no slot: reported as slot-range
     callee = program.macros.get(op.arg)
     if callee is None:
-        report.add("undefined-macro", op.span or caller.span,
-                   f"EM{op.arg}: no macro {op.arg} is defined here, so the controller does "
-                   "nothing (unless the macro is already stored on it)")
+        report.add("undefined-macro", op.span or caller.span, slot=op.arg)
         return
     remainder = caller.ops[index + 1:]
     if not remainder:
         return
-    chain = _goto_chain(program, callee) if op.role == "call" else None
+    chain = _goto_chain(program, callee) if op.role == Role.CALL else None
     if chain:
-        rest = ",".join(o.text for o in remainder)
-        report.add("nested-call", op.span or caller.span,
-                   f"{caller.label} calls {callee.label} and continues ({rest}), but "
-                   f"{' -> '.join(chain)} transfers for good: the call never comes back, so "
-                   f"the rest of {caller.label} never runs after it. Write `goto` if the "
-                   "caller need not continue, or make the called macro end without a goto",
-                   Severity.ERROR)
+        report.add("nested-call", op.span or caller.span, "goto", severity=Severity.ERROR,
+                   caller=caller.label, callee=callee.label, chain=" -> ".join(chain),
+                   rest=",".join(o.text for o in remainder))
         return
     if _returns(program, callee, remainder):
         return
     inner = program.macros[next(o.arg for o in callee.ops
                                 if o.mnemonic == "EM" and o.arg in program.macros)]
-    rest = ",".join(o.text for o in remainder)
-    message = (f"{caller.label} calls {callee.label} and continues ({rest}), but "
-               f"{callee.label} calls {inner.label}: the controller keeps one return point "
-               f"(MS176E §3.8.4), so the rest of {caller.label} never runs after that")
-    if op.role == "raw":
-        report.add("nested-call", op.span or caller.span, message, Severity.WARNING)
-    else:
-        report.add("nested-call", op.span or caller.span,
-                   message + _advice(op, callee, inner), Severity.ERROR)
+    raw = op.role == Role.RAW  # on raw blocks the manual's own way of switching modes
+    report.add("nested-call", op.span or caller.span, "" if raw else _advice(op, inner),
+               severity=Severity.WARNING if raw else Severity.ERROR, caller=caller.label,
+               callee=callee.label, inner=inner.label, rest=",".join(o.text for o in remainder),
+               max=MAX_COMMANDS)
 
 
 def _returns(program: Program, callee: Macro, remainder: list[Op]) -> bool:
@@ -116,9 +99,9 @@ def _ends_on_purpose(program: Program, macro: Macro, then: int | None) -> bool:
         last = macro.ops[-1]
         if last.mnemonic != "EM":
             return False
-        if last.role == "goto" or (last.role == "continue" and last.arg == then):
+        if last.role == Role.GOTO or (last.role == Role.CONTINUE and last.arg == then):
             return True  # raw EMs never count: on raw blocks the rule is the manual's, as written
-        if last.role != "continue" or last.arg not in program.macros:
+        if last.role != Role.CONTINUE or last.arg not in program.macros:
             return False
         seen.add(macro.slot)
         macro = program.macros[last.arg]
@@ -137,23 +120,19 @@ def _goto_chain(program: Program, callee: Macro) -> list[str] | None:
             target = program.macros.get(o.arg) if o.mnemonic == "EM" else None
             if target is None:
                 continue
-            if o.role == "goto":
+            if o.role == Role.GOTO:
                 return path + [f"goto {target.label}"]
-            if o.role in ("hoist", "continue") and target.slot not in seen:
+            if o.role in (Role.HOIST, Role.CONTINUE) and target.slot not in seen:
                 seen.add(target.slot)
                 todo.append((target, path + [target.label]))
     return None
 
 
-def _advice(op: Op, callee: Macro, inner: Macro) -> str:
-    if inner.origin == "part":
-        return (f". {callee.label} holds more than {MAX_COMMANDS} commands, so it was chained "
-                "into parts, and a called macro must fit in one: shorten it, or `goto` it")
-    if op.role == "call":
-        return (". Use `goto` if the caller need not continue, or make the called macro call "
-                "nothing (a split or hoisted block calls on too)")
-    return (". Inside a repeat or every loop a when block may run commands or end in a goto, "
-            "but not call macros; move those commands into the block")
+def _advice(op: Op, inner: Macro) -> str:
+    """The `nested-call` message variant that says what to do about it."""
+    if inner.origin == Origin.PART:
+        return "split"  # the callee was chained into parts
+    return "call" if op.role == Role.CALL else "loop"
 
 
 def _reachability(program: Program, report: Report) -> None:
@@ -166,7 +145,5 @@ def _reachability(program: Program, report: Report) -> None:
                 seen.add(op.arg)
                 todo.append(op.arg)
     for m in program.macros.values():
-        if m.slot not in seen and m.origin in _USER_ORIGINS and m.name not in program.inlined:
-            report.add("unreachable-macro", m.span,
-                       f"{m.label} is not reached from the autostart macro; it runs only when "
-                       "the host starts it")
+        if m.slot not in seen and m.origin in USER_ORIGINS and m.name not in program.inlined:
+            report.add("unreachable-macro", m.span, macro=m.label)

@@ -2,7 +2,8 @@
 
 POSIX only (os.openpty). The server keeps its own handle on the terminal
 side open, so hosts may open and close the path as often as they like, and
-a `vanish` fault closes both ends to look like a pulled USB cable.
+a `vanish` fault closes both ends to look like a pulled USB cable. With a
+log, every byte both ways goes to it as it passes, timestamped.
 """
 from __future__ import annotations
 
@@ -12,8 +13,11 @@ import select
 import threading
 import time
 import tty
+from typing import IO
 
 from mercmac.emulator.virtual import VirtualController
+from mercmac.outfile import reason
+from mercmac.upload.protocol import show
 
 TICK_S = 0.002  # how often running macros advance when no bytes arrive
 log = logging.getLogger(__name__)
@@ -22,7 +26,7 @@ log = logging.getLogger(__name__)
 class PtyServer:
     """A VirtualController behind a pty; `path` is what to give `mercmac flash`."""
 
-    def __init__(self, controller: VirtualController):
+    def __init__(self, controller: VirtualController, log: IO[str] | None = None):
         if not hasattr(os, "openpty"):
             raise OSError("pseudo-terminals need a POSIX system (Linux, macOS)")
         self.controller = controller
@@ -35,6 +39,9 @@ class PtyServer:
         self._thread: threading.Thread | None = None
         self._t0 = time.monotonic()
         self._failures: set[str] = set()  # logged once each, however often they recur
+        self._log = log  # `mercmac emulate --log`: the caller opens and closes it
+        self._note(f"# {time.strftime('%Y-%m-%d %H:%M:%S %z')} virtual {controller.model} on "
+                   f"{self.path}; seconds since then, -> host to controller, <- back")
 
     def __enter__(self) -> "PtyServer":
         self.start()
@@ -54,10 +61,12 @@ class PtyServer:
             ready, _, _ = select.select([self._master], [], [], TICK_S)
             now = time.monotonic() - self._t0
             data = self._read() if ready else b""
+            if data:
+                self._record(now, "->", data)
             with self._lock:
                 out, vanished = self._serve(data, now)
             if out:
-                self._write(out)
+                self._send(out, time.monotonic() - self._t0)
             if vanished:
                 self._close_fds()
                 return
@@ -87,17 +96,39 @@ class PtyServer:
             self._thread.join(timeout=2)
         self._close_fds()
 
+    def _record(self, now: float, way: str, data: bytes) -> None:
+        """One line of the log: time, direction, the bytes in hex and as text (<CR>, <ETX>)."""
+        self._note(f"{now:12.6f} {way} {data.hex(' ')}  {show(data)}")
+
+    def _note(self, line: str) -> None:
+        if self._log is None:
+            return
+        try:
+            self._log.write(line + "\n")  # line-buffered: a `tail -f` sees each at once
+        except (OSError, ValueError) as e:  # disk full, file closed: serving goes on
+            log.error("emulator: the log stopped (%s); still serving", reason(e))
+            self._log = None
+
     def _read(self) -> bytes:
         try:
             return os.read(self._master, 4096)
         except OSError:
             return b""
 
-    def _write(self, data: bytes) -> None:
+    def _send(self, data: bytes, now: float) -> None:
+        # logged first: a host (or Ctrl-C) that acts on the reply at once finds it in the log
+        self._record(now, "<-", data)
+        sent = self._write(data)
+        if sent < len(data):
+            self._note(f"{now:12.6f} <- the last {len(data) - sent} of these bytes were lost: "
+                       "the host does not read")
+
+    def _write(self, data: bytes) -> int:
+        """How many bytes went out; the rest is lost, as on a real wire."""
         try:
-            os.write(self._master, data)
+            return os.write(self._master, data)
         except OSError:
-            pass  # buffer full or nobody listening: bytes are lost, as on a real wire
+            return 0  # buffer full or nobody listening
 
     def _close_fds(self) -> None:
         for name in ("_master", "_slave"):

@@ -2,7 +2,9 @@
 
 `VirtualController` is the firmware's front end: address selection, line
 assembly, CR repetition, stop-on-character, the 20 ms character gap of
-firmware 1.xx, and the macro commands (MD, RM, RMALL, RZ, TM, TZ). Everything
+firmware 1.xx, a typed line's commands running before the bytes written after
+it are read (hosts pipeline: `MA10000\rTS\r` in one write), and the macro
+commands (MD, RM, RMALL, RZ, TM, TZ). Everything
 else (motion, waits, reports, TS, TB, VE, running stored macros) is the
 simulator's VM, `mercmac.vm.Machine`, advanced with wall time; its reports
 module formats every report. `Faults` makes it misbehave the way real links
@@ -16,14 +18,14 @@ from __future__ import annotations
 
 import json
 import logging
-import re
 from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
-from mercmac.commands import C863, COMMANDS, SINGLE_CHARS, Arg
-from mercmac.compiler.program import Macro, Op, Program
+from mercmac import mdtext
+from mercmac.commands import C863, SINGLE_CHARS
+from mercmac.compiler.program import Macro, Op, Origin, Program
 from mercmac.errors import UsageError
 from mercmac import outfile
 from mercmac.outfile import OutputError, writable_target, write_text
@@ -34,7 +36,18 @@ from mercmac.vm.assemble import DIRECT
 
 REPORT_END = b"\r\n\x03"  # MS176E §6.1.3: CR LF ETX after every report
 CHAR_GAP_S = 0.020  # MS176E §2 notes: firmware 1.xx drops a line whose characters are > 20 ms apart
-MAX_COMMANDS = 16  # MS176E §3.8: up to 16 base commands per macro
+BITS_PER_CHAR = 10  # 8N1 on the wire: start bit, 8 data bits, stop bit (Faults.pace)
+# Faults.pace: our model of a controller busy with a move, which the manual does not
+# describe: while the axis moves, a byte that follows the last one taken by less than
+# this is lost (its receiver is read only this often), so text typed at full speed during
+# a move arrives garbled, and single-character commands sent alone get through.
+MOVE_POLL_S = 0.002
+MAX_COMMANDS = mdtext.MAX_COMMANDS  # MS176E §3.8: up to 16 base commands per macro
+# A typed line runs its commands that do not wait (at most 16, one cycle each, SPEC §3
+# Time) before the next byte is read: a real controller takes microseconds for them, less
+# than one character time, so `MA10000\rTS\r` in one write runs the MA. A line that loops
+# without waiting is interrupted after that many cycles by the next character (§6.1.1).
+SETTLE_CYCLES = MAX_COMMANDS + 1  # + 1: the cycle that ends the line
 # TS error codes (MS176E §6.4 TS, block 6 / block 3); the C-663 list ends at 06 too
 ERR_TIMEOUT, ERR_OVERFLOW, ERR_STORAGE = 0x01, 0x02, 0x03
 ERR_MACRO_RANGE, ERR_MACRO_COMMAND, ERR_COMMAND = 0x04, 0x05, 0x06
@@ -45,7 +58,6 @@ ERR_MACRO_RANGE, ERR_MACRO_COMMAND, ERR_COMMAND = 0x04, 0x05, 0x06
 MAX_LINE = 256
 LINES_KEPT = 10_000  # `lines` keeps the most recent ones: an emulator may run for weeks
 _MACRO_COMMANDS = {"MD", "RM", "RMALL", "RZ", "TM", "TZ", "VE"}
-_TOKEN = re.compile(r"^([A-Z]+\??)([+-]?[0-9]+)?$")
 _STATE_KEYS = ("model", "macros")
 log = logging.getLogger(__name__)
 
@@ -71,6 +83,11 @@ class Faults:
     garble: bool = False  # replies arrive mangled, as at a wrong baud rate
     char_gap: bool | None = None  # enforce the 20 ms gap; None = as the firmware version says
     md_delay: float = 0.0  # seconds a flash write keeps the controller from reading on
+    # like real hardware: bytes reach the firmware at `baud`, firmware 1.xx's 20 ms gap holds
+    # whatever VE says, and characters are lost while a move runs (MOVE_POLL_S)
+    pace: bool = False
+    baud: int = 9600
+    version: str | None = None  # VE answers this instead (older firmware, the C-862)
 
 
 class VirtualController:
@@ -85,7 +102,12 @@ class VirtualController:
         self.lines: deque[str] = deque(maxlen=LINES_KEPT)  # command lines, for tests and benchmarks
         self.md_count = 0
         self.busy_until = 0.0  # while storing a macro, further bytes wait in the input buffer
-        self._held = bytearray()
+        # bytes from the host not yet read by the firmware: [time written, bytes] per write
+        self._held: deque[tuple[float, bytearray]] = deque()
+        self._wire_at = -1.0  # when the last byte read from `_held` reached the controller
+        self._taken_at = -1.0  # ... and the last one the firmware took (not lost, Faults.pace)
+        self._settle_until = 0.0  # a typed line's commands run before the next byte until then
+        self.lost = 0  # bytes lost while a move ran (Faults.pace)
         self.vanished = False
         self.selected = False
         self._out = bytearray()
@@ -96,7 +118,7 @@ class VirtualController:
         self._last_line: str | None = None
         self._awaiting_address = False
         self._now = 0.0
-        self.machine = Machine(model=model, options=Options(address=address),
+        self.machine = Machine(model=model, options=Options(address=address, firmware=firmware),
                                on_report=lambda t_ms, text: self.report(text))
         exists = self.state is not None and self.state.exists()
         self._store(load_state(self.state, model) if exists else dict(macros or {}))
@@ -108,11 +130,16 @@ class VirtualController:
     @property
     def macros(self) -> dict[int, str]:
         """What the flash memory holds, as TM would list it."""
-        return {slot: chunk.line for slot, chunk in sorted(self.machine.chunks.items())}
+        return self.machine.stored_macros()
 
     @property
     def running(self) -> bool:
         return self.machine.running
+
+    @property
+    def waiting(self) -> int:
+        """Bytes the host sent that the firmware has not read yet (a line still runs, ...)."""
+        return sum(len(data) for _, data in self._held)
 
     def power_on(self, now: float) -> None:
         """Deselected, defaults restored, macro 0 started if stored (MS176E §3.1, §3.8.5)."""
@@ -125,14 +152,25 @@ class VirtualController:
         self._self_select()
 
     def tick(self, now: float) -> None:
-        """Let running macros advance to wall time `now` (seconds since power-on)."""
+        """Let running macros advance to wall time `now` (seconds since power-on), and read
+        the bytes that have arrived by then, one at a time, as the firmware does."""
         self._run(now)
         self._self_select()
         self._now = now
         while self._held and now >= self.busy_until and not self.vanished:
-            byte = self._held[0]
-            del self._held[0]  # O(1) at the front of a bytearray; pop(0) copies the rest
-            self._safely(f"byte 0x{byte:02X}", self._byte, byte, now)
+            written, data = self._held[0]
+            at = self._arrival(written)
+            if at > now or self._settling(now):
+                return
+            byte = data[0]
+            del data[0]  # O(1) at the front of a bytearray; pop(0) copies the rest
+            if not data:
+                self._held.popleft()
+            self._wire_at = at
+            if self._lost(at):
+                continue
+            self._taken_at = at
+            self._safely(f"byte 0x{byte:02X}", self._byte, byte, at)
 
     def take(self) -> bytes:
         """Bytes waiting to go to the host."""
@@ -143,9 +181,29 @@ class VirtualController:
         return data
 
     def receive(self, data: bytes, now: float) -> None:
-        """Bytes from the host, one at a time, as the firmware sees them."""
-        self._held += data  # held while a macro is being stored (Faults.md_delay)
+        """Bytes the host wrote at `now`; `tick` hands them to the firmware in order."""
+        if data:
+            self._held.append((now, bytearray(data)))
         self.tick(now)
+
+    def _arrival(self, written: float) -> float:
+        """When the next byte of a write made at `written` has reached the controller."""
+        if not self.faults.pace:
+            return written  # a pseudo-terminal has no baud rate: the whole write is there
+        return max(written, self._wire_at) + BITS_PER_CHAR / self.faults.baud  # after the last
+
+    def _settling(self, now: float) -> bool:
+        """Whether the line the host typed is still running commands that do not wait, so
+        the next byte waits in the receive buffer (SETTLE_CYCLES); a wait lets it in."""
+        m = self.machine
+        return now < self._settle_until and m.next_command_ms() <= m.now_ms + m.cycle_ms
+
+    def _lost(self, at: float) -> bool:
+        """Faults.pace: a byte too close behind the last one while a move runs (MOVE_POLL_S)."""
+        if not (self.faults.pace and at - self._taken_at < MOVE_POLL_S and self.machine.moving()):
+            return False
+        self.lost += 1
+        return True
 
     def report(self, text: str) -> None:
         """Send a report if selected; deselected controllers stay silent (MS176E §5.1, §5.6)."""
@@ -156,13 +214,19 @@ class VirtualController:
         """Advance the VM to wall time `now`; a failure stops the macro, not the controller."""
         self._safely("a running macro", self.machine.run_until, now * 1000)
 
+    def _run_due(self, now: float) -> None:
+        """Also run what is due at `now` itself: the first command of a line just typed,
+        whose report must come before anything the host sends after it."""
+        due = max(now * 1000, self.machine.now_ms) + 0.001  # 1 us: the VM counts in us
+        self._safely("a running macro", self.machine.run_until, due)
+
     def _safely(self, what: str, work: Callable, *args) -> None:
         """Run one step of the firmware; a bug in it is error 06 and a message, never a crash."""
         try:
             work(*args)
         except Exception as e:  # noqa: BLE001 - the controller must go on serving
             self.machine.stop()
-            self.machine.error = ERR_COMMAND
+            self.machine.set_error(ERR_COMMAND)
             self._log_once(f"emulator: {what} failed ({type(e).__name__}: {e}); "
                            "answered with error 06 and went on")
 
@@ -173,7 +237,7 @@ class VirtualController:
 
     def _self_select(self) -> None:
         """SCn in the autostart macro selects the controller (MS176E §3.1.2)."""
-        if self.machine.params.pop("SC", None) == self.address:
+        if self.machine.take_self_select() == self.address:
             self.selected = True
 
     # -- the byte-level rules -----------------------------------------------
@@ -189,8 +253,13 @@ class VirtualController:
         if byte == protocol.SELECT:
             self._awaiting_address = True
             return
-        if not self.selected or byte in (protocol.NUL, protocol.LF):
-            return  # MS176E §5.1: deselected, everything but address codes is ignored
+        if not self.selected or byte in (protocol.NUL, protocol.LF, protocol.ETX):
+            # MS176E §5.1: deselected, everything but address codes is ignored. NUL comes from
+            # adapters; LF and ETX end reports (§6.1.3), never commands (CR does, §6.1.2), but
+            # hosts that frame commands like reports send them after the CR (PI's GCS ends
+            # lines with LF, §5.2; basil's serial transport appends ETX by default). Taken as
+            # characters they would stop a macro just started and spoil the next command.
+            return
         char = chr(byte)
         if not self._line and not self._overflow and char in SINGLE_CHARS:
             self._single(char)  # MS176E §6.3: executed at once, a macro keeps running
@@ -204,14 +273,14 @@ class VirtualController:
         if (self._line or self._overflow) and self._timed_out(now):
             self._line.clear()  # firmware 1.xx: characters too far apart, line dropped
             self._overflow = False
-            self.machine.error = ERR_TIMEOUT
+            self.machine.set_error(ERR_TIMEOUT)
         self._last_char_at = now
         if self._overflow:
             return  # the rest of an overlong line goes nowhere
         if len(self._line) >= MAX_LINE:
             self._line.clear()
             self._overflow = True
-            self.machine.error = ERR_OVERFLOW
+            self.machine.set_error(ERR_OVERFLOW)
             return
         self._line.append(byte)
 
@@ -224,7 +293,7 @@ class VirtualController:
             return
         if self._line and self._timed_out(now):
             self._line.clear()
-            self.machine.error = ERR_TIMEOUT
+            self.machine.set_error(ERR_TIMEOUT)
             return
         if not self._line:
             if self._last_line is not None:  # MS176E §5.2: a bare CR repeats the last line
@@ -238,6 +307,8 @@ class VirtualController:
     def _gap_limited(self) -> bool:
         if self.faults.char_gap is not None:
             return self.faults.char_gap
+        if self.faults.pace:
+            return True  # the hardest case a host meets: firmware 1.xx (MS176E §2 notes)
         return self.firmware.startswith("1.")
 
     # -- commands -------------------------------------------------------------
@@ -246,18 +317,21 @@ class VirtualController:
         """MS176E §6.3: the same report as the equivalent command; `\\` is 0 or 1 (moving)."""
         equivalent = SINGLE_CHARS[char].equivalent
         if equivalent is None:
-            self.report("1" if self.machine.axis.moving(self.machine.clock.now) else "0")
+            self.report("1" if self.machine.moving() else "0")
         elif equivalent == "AB":
             self.machine.execute_line([Op("AB")])
+        elif equivalent == "TS":
+            self.report(self.machine.read_status())  # "%" equals TS (§6.1.3): it reads the error
         elif char in ("+", "(") and self.model != C863:
             return  # TE/TF exist on the C-863 only (§6.3 footnote)
         else:
-            name, arg = _split(equivalent)
-            self.report(reports.report(name, arg, self.machine))
+            [op] = mdtext.parse_line(equivalent, stored=False).ops  # 'TA2' -> TA 2
+            self.report(reports.report(op.mnemonic, op.arg, self.machine))
 
     def _execute(self, text: str, now: float) -> None:
         self.lines.append(text)
-        self._safely(f"the line {text[:40]!r}", self._command, _canonical(text), now)
+        self._settle_until = now + SETTLE_CYCLES * self.machine.cycle_ms / 1000
+        self._safely(f"the line {text[:40]!r}", self._command, mdtext.canonical(text), now)
         self._save()
 
     def _command(self, line: str, now: float) -> None:
@@ -266,31 +340,30 @@ class VirtualController:
             self._define(line)
             return
         try:
-            ops = _ops(line, DIRECT)
+            ops = self._ops(line, DIRECT)
         except BadLine:
-            self.machine.error = ERR_COMMAND
+            self.machine.set_error(ERR_COMMAND)
             return
         if all(op.mnemonic in _MACRO_COMMANDS for op in ops):
             for op in ops:
                 self._macro_command(op.mnemonic, op.arg, now)
         else:
             self.machine.execute_line(ops)
-            self._run(now)  # reports of the line come at once
+            self._run_due(now)  # its first command runs now, its report comes at once
 
     def _define(self, line: str) -> None:
         """MDn,...: store silently, overwriting (MS176E §3.8.1, §6.4 MD)."""
         self.md_count += 1
         line = self._lose_character(line)
-        head, _, body = line.partition(",")
-        slot = _number(head[2:])
+        slot, body = mdtext.split_md(line)
         if slot is None or not 0 <= slot <= 31:
-            self.machine.error = ERR_MACRO_RANGE
+            self.machine.set_error(ERR_MACRO_RANGE)
         else:
             try:
-                self.machine.define(slot, _ops(body, slot))
+                self.machine.define(slot, self._ops(body, slot))
                 self.busy_until = self._now + self.faults.md_delay
             except BadLine:
-                self.machine.error = ERR_MACRO_COMMAND
+                self.machine.set_error(ERR_MACRO_COMMAND)
         if self.faults.vanish_after_md is not None and self.md_count >= self.faults.vanish_after_md:
             self.vanished = True
 
@@ -298,7 +371,7 @@ class VirtualController:
         faults = self.faults
         index = faults.drop_char.get(self.md_count)
         if index is None and faults.always_drop_slot is not None:
-            if _number(line.partition(",")[0][2:]) == faults.always_drop_slot:
+            if mdtext.split_md(line)[0] == faults.always_drop_slot:
                 index = len(line) // 2
         if index is None or not line:
             return line
@@ -307,11 +380,10 @@ class VirtualController:
 
     def _macro_command(self, name: str, arg: int | None, now: float) -> None:
         if name == "VE":
-            text = reports.report("VE", None, self.machine)
-            self.report(text.replace("Ver. 2.30", f"Ver. {self.firmware}"))
+            self.report(self.faults.version or reports.report("VE", None, self.machine))
         elif name in ("TZ", "TM"):
             self._tell([0] if name == "TZ" else [arg] if arg else
-                       [s for s in sorted(self.machine.chunks) if s > 0], listing=name == "TM" and not arg)
+                       [s for s in self.machine.stored_macros() if s > 0], listing=name == "TM" and not arg)
         else:  # RZ, RMn, RM, RMALL (§6.4): the VM erases; the state file follows
             self.machine.execute_line([Op(name, arg)])
             self.machine.run_until(now * 1000 + 1)
@@ -339,61 +411,34 @@ class VirtualController:
             save_state(self.state, macros, self.model)
         except OutputError as e:  # the folder went away, the disk is full, ...
             log.error("emulator: %s; error 03, the macros stay as they were", e.message)
-            self.machine.error = ERR_STORAGE  # MS176E §6.4 TS: 03 macro storage full
+            self.machine.set_error(ERR_STORAGE)  # MS176E §6.4 TS: 03 macro storage full
             self._store(self._saved)
         else:
             self._saved = macros
 
     def _store(self, macros: dict[int, str]) -> None:
         """Make the flash memory hold exactly these macros."""
-        self.machine.load(Program({s: _macro(s, _ops(text, s)) for s, text in macros.items()},
+        self.machine.load(Program({s: _macro(s, self._ops(text, s)) for s, text in macros.items()},
                                   self.model))
 
-
-def _split(token: str) -> tuple[str, int | None]:
-    """'TM12' -> ('TM', 12); 'RMALL' -> ('RMALL', None)."""
-    m = re.match(r"([A-Z]+\??)(.*)$", token)
-    name, rest = (m.group(1), m.group(2)) if m else (token, "")
-    return name, _number(rest)
+    def _ops(self, line: str, slot: int) -> list[Op]:
+        """The ops of a line, checked as `mercmac check` checks it (range, model, macro rules)."""
+        return _ops(line, slot, self.model)
 
 
-def _number(text: str) -> int | None:
-    """'12', '+5', '-3' as an int; anything else (also '1_0', '') None."""
-    return int(text) if re.fullmatch(r"[+-]?[0-9]+", text) else None
-
-
-def _canonical(text: str) -> str:
-    """A line as the firmware reads it: upper case, blanks dropped (MS176E §6.1.2)."""
-    return re.sub(r"\s+", "", text.upper())
-
-
-def _ops(body: str, slot: int) -> list[Op]:
-    """The base commands of a line; BadLine names the first that is unknown or out of range."""
-    ops = [_op(token, slot) for token in body.split(",") if token]  # `DI,`: MS176E §3.8.6 Ex. 4
-    if not ops:
+def _ops(line: str, slot: int, model: str | None = None) -> list[Op]:
+    """The base commands of a line, read by mercmac.mdtext; BadLine says what is wrong."""
+    stored = slot != DIRECT
+    parsed = mdtext.parse_line(line, model=model, stored=stored, slot=slot if stored else None)
+    if parsed.errors:
+        raise BadLine(parsed.errors[0].message)
+    if not parsed.ops:
         raise BadLine("no command")
-    if len(ops) > MAX_COMMANDS:
-        raise BadLine(f"{len(ops)} commands, more than the {MAX_COMMANDS} a macro holds")
-    return ops
-
-
-def _op(token: str, slot: int) -> Op:
-    """One command, its argument checked against the command table (as `mercmac check` does)."""
-    m = _TOKEN.match(token)
-    spec = COMMANDS.get(m.group(1)) if m else None
-    if spec is None:
-        raise BadLine(f"{token[:20]!r} is not a command")
-    if slot != DIRECT and not spec.storable:
-        raise BadLine(f"{spec.mnemonic} cannot stand in a macro")
-    arg = _number(m.group(2) or "")
-    missing = arg is None and spec.arg is Arg.REQUIRED
-    if missing or (arg is not None and (spec.arg is Arg.NONE or not spec.in_range(arg))):
-        raise BadLine(f"{spec.expects()}, not {token[:20]!r}")
-    return Op(spec.mnemonic, arg)
+    return list(parsed.ops)
 
 
 def _macro(slot: int, ops: list[Op]) -> Macro:
-    return Macro(slot, f"MC{slot:02d}", ops, origin="stored")
+    return Macro(slot, f"MC{slot:02d}", ops, origin=Origin.STORED)
 
 
 def _state_target(path: Path) -> Path:
@@ -427,7 +472,7 @@ def load_state(path: Path, model: str) -> dict[int, str]:
     macros = data.get("macros", {})
     if not isinstance(macros, dict):
         raise _unreadable(path, "'macros' is not an object of macro numbers and lines")
-    return dict(_state_entry(path, key, text) for key, text in macros.items())
+    return dict(_state_entry(path, key, text, model) for key, text in macros.items())
 
 
 def _no_duplicates(pairs: list[tuple[str, object]]) -> dict:
@@ -440,18 +485,18 @@ def _no_duplicates(pairs: list[tuple[str, object]]) -> dict:
     return data
 
 
-def _state_entry(path: Path, key: str, text: object) -> tuple[int, str]:
+def _state_entry(path: Path, key: str, text: object, model: str) -> tuple[int, str]:
     """One stored macro: upper-cased and checked as an MD line would be (MS176E §6.4 MD)."""
-    slot = _number(key) if key.isascii() else None
+    slot = mdtext.number(key) if key.isascii() and key.strip() == key else None
     if slot is None or not 0 <= slot <= 31:
         raise _unreadable(path, f"{key!r} is not a macro number 0-31")
     if not isinstance(text, str):
         raise _unreadable(path, f"macro {slot} is not a line of text")
     try:
-        ops = _ops(_canonical(text), slot)
+        ops = _ops(mdtext.canonical(text), slot, model)
     except BadLine as e:
         raise _unreadable(path, f"macro {slot} is not a valid macro line: {e}") from None
-    return slot, ",".join(op.text for op in ops)
+    return slot, mdtext.format_ops(ops)
 
 
 def _unreadable(path: Path, why: str) -> StateError:

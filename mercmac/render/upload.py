@@ -17,7 +17,7 @@ _FATE_STYLE = {"written": "bold green", "erased": "bold yellow", "re-written las
 def identity_lines(port: str, address: int, identity, warning: str | None = None) -> list[Line]:
     """'C-863, firmware 2.30, at address 0 on /dev/ttyUSB0' and what we had to do."""
     v = identity.version
-    lines: list[Line] = [[("controller: ", "bold"), (f"{v.model}, firmware {v.firmware}", "cyan"),
+    lines: list[Line] = [[("controller: ", "bold"), (f"{v.name}, firmware {v.firmware}", "cyan"),
                           (f", at address {address} on {port}", "")]]
     if identity.stopped_macro:
         lines.append([("note: ", "bold yellow"), ("a macro was running; it was stopped", "")])
@@ -134,7 +134,7 @@ def pulled_lines(pulled, port: str, address: int, output: str | None) -> list[Li
     v = pulled.identity.version
     where = f" into {output}" if output else ""
     return [[("read ", ""), (f"{len(pulled.macros)} macros", "bold"),
-             (f" from the {v.model} (firmware {v.firmware}) at address {address} on {port}{where}", "")]]
+             (f" from the {v.name} (firmware {v.firmware}) at address {address} on {port}{where}", "")]]
 
 
 def scan_lines(found, port: str) -> list[Line]:

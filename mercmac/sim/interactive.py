@@ -64,7 +64,7 @@ def _loop(machine: Machine, speed: float, fd: int, out: IO[str]) -> int:
                 return 0
             if key in "123456":
                 n = int(key)
-                machine.set_input(n, not machine.inputs[n])
+                machine.set_input(n, not machine.input(n))
         _show(pending, machine, out)
 
 
@@ -84,8 +84,7 @@ def _show(pending: list, machine: Machine, out: IO[str]) -> None:
     if lines:
         out.write(CLEAR)
         write_lines(lines, out)
-    label = machine.chunk.label if machine.chunk is not None else "direct mode"
-    out.write(CLEAR + render.live_status(machine.clock.now, machine.outputs_pattern(),
-                                         machine.inputs.state, machine.position(),
-                                         machine.target, label))
+    out.write(CLEAR + render.live_status(machine.now_us, machine.outputs_pattern(),
+                                         machine.input_lines(), machine.position(),
+                                         machine.target, machine.label or "direct mode"))
     out.flush()

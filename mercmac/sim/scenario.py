@@ -265,9 +265,9 @@ def check(m: Machine, expect: Expect) -> None:
 def next_change_ms(m: Machine) -> float:
     """When the checked state may change next: an event, a command, or 1 ms on while moving."""
     t = m.next_event_ms()
-    if m.axis.moving(m.clock.now):
+    if m.moving():
         t = min(t, m.now_ms + 1)
-    return t if t > m.now_ms else m.now_ms + m.clock.cycle / 1000
+    return t if t > m.now_ms else m.now_ms + m.cycle_ms
 
 
 def run(m: Machine, scenario: Scenario, until_ms: int) -> int:

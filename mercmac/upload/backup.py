@@ -26,10 +26,10 @@ def to_mcm(macros: dict[int, str], version: Version, *, port: str, address: int,
         "// Mercury(TM) Macro File",
         f"// read by mercmac {__version__} from {port}, address {address}, "
         f"on {when.isoformat(timespec='seconds')}",
-        f"// controller: {version.model}, firmware {version.firmware}",
+        f"// controller: {version.name}, firmware {version.firmware}",
         f"// VE: {_comment_safe(version.text)}",
         f"// {len(macros)} macro{'s' if len(macros) != 1 else ''} stored",
-        f"target {version.model}",
+        f"target {version.model}" if version.model else "// no `target`: VE names no known model",
         "",
     ]
     body = [f"[MC{slot:02d}] {text}" for slot, text in sorted(macros.items())]

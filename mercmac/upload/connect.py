@@ -9,9 +9,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Callable, Iterator
 
+from mercmac.commands import MODELS
 from mercmac.upload.controller import BadReply, Controller, ControllerError, Flood, LinkLost, NoAnswer
 from mercmac.upload.errors import PortError, Refused
-from mercmac.upload.protocol import Version
+from mercmac.upload.protocol import Version, quote
 from mercmac.upload.transport import DEFAULT_BAUD, PortUnavailable, Timing, Transport
 
 
@@ -73,8 +74,11 @@ def refusal(controller: Controller, e: ControllerError) -> Refused:
 
 
 def check_model(identity: Identity, target: str | None, file: str, *, force: bool) -> str | None:
-    """Refuse when the controller is not the file's target; with force, the warning to show."""
+    """Refuse when the controller is not the file's target; with force, the warning to show.
+    A controller whose VE names no model mercmac knows is taken to be the target."""
     model = identity.version.model
+    if model is None:
+        return _unknown_model(identity.version, target, file)
     if target is None or target == model:
         return None
     text = f"the controller is a {model}, but {file or 'the program'} targets the {target}"
@@ -83,6 +87,18 @@ def check_model(identity: Identity, target: str | None, file: str, *, force: boo
     raise Refused(text + "; nothing was written",
                   hint=f"use --force to flash it anyway, or --target {model} to check the "
                        f"file against this controller")
+
+
+def _unknown_model(version: Version, target: str | None, file: str) -> str:
+    """A VE that names no model mercmac knows (older firmware, the C-862 predecessor): go on
+    as the program's target, and say so; refuse only when there is no target to go on with."""
+    said = (f"VE answered {quote(version.text)}, which names no model mercmac knows "
+            f"({' or '.join(MODELS)})")
+    if target is None:
+        raise Refused(f"{said}, and {file or 'the program'} names no `target`; nothing was written",
+                      hint=f"give the model to flash it as: --target {' or '.join(MODELS)}, "
+                           f"or a `target` line in the file")
+    return f"{said}; going on as the {target} the program targets"
 
 
 def _where(controller: Controller) -> str:

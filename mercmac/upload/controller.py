@@ -10,6 +10,7 @@ from __future__ import annotations
 import time
 from typing import Callable
 
+from mercmac import mdtext
 from mercmac.upload import protocol
 from mercmac.upload.protocol import ProtocolError, Status, Version
 from mercmac.upload.transport import LONGEST_REPLY, PortLost, ReadTimeout, Transport, TransportError
@@ -70,17 +71,17 @@ class Controller:
 
     def identify(self) -> Version:
         """VE: model and firmware (§3.3). Its first character also stops a running macro (§3.8.3)."""
-        return protocol.parse_version(self._ask("VE", protocol.is_version))
+        return protocol.parse_version(self._ask(mdtext.ve(), protocol.is_version))
 
     def read_slot(self, slot: int) -> str | None:
         """One macro by `TMn`, or `TZ` for macro 0 (`TM0` lists all but 0); None when empty."""
-        line = "TZ" if slot == 0 else f"TM{slot}"
+        line = mdtext.tell(slot)
         report = self._ask(line, lambda r: _lists_only(r, {slot}))
         return self._macros(report, line).get(slot)
 
     def read_all(self) -> dict[int, str]:
         """Every stored macro: `TM` for 1-31 in either framing of SPEC §4, then `TZ`."""
-        first = self._ask("TM", lambda r: _lists_only(r, LISTED))
+        first = self._ask(mdtext.tm(), lambda r: _lists_only(r, LISTED))
         stop = time.monotonic() + self.transport.timing.budget(self.transport.baud)
         macros = self._macros(first, "TM")
         if len(protocol.lines(first)) == 1:
@@ -94,20 +95,15 @@ class Controller:
 
     def define(self, slot: int, line: str) -> None:
         """MDn,...: store a macro; the controller neither answers nor warns (§3.8.1)."""
-        self._send(protocol.command(f"MD{slot},{line}"))
+        self._send(protocol.command(mdtext.md(slot, line)))
 
     def remove(self, slot: int) -> None:
         """Erase one macro: `RZ` for 0, `RMn` otherwise; never a bare `RM`, which erases all (§6.4 RM)."""
-        if slot == 0:
-            self._send(protocol.command("RZ"))
-        elif 1 <= slot <= 31:
-            self._send(protocol.command(f"RM{slot}"))
-        else:
-            raise ValueError(f"no macro slot {slot}")
+        self._send(protocol.command(mdtext.remove(slot)))  # ValueError outside 0-31
 
     def reset(self) -> None:
         """RT: restart as after power-on, so macro 0 runs; the controller is then deselected (§6.4 RT, §3.1)."""
-        self._send(protocol.command("RT"))
+        self._send(protocol.command(mdtext.rt()))
 
     def _send(self, data: bytes) -> None:
         try:

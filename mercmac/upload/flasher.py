@@ -7,16 +7,20 @@ that says what was written, what was not, and where the backup is.
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator
 
+from mercmac.compiler import Compilation, compile_file
 from mercmac.compiler.program import Program
+from mercmac import mdtext
 from mercmac.upload import backup, protocol
 from mercmac.upload.controller import Controller, ControllerError, LinkLost
 from mercmac.upload.errors import FlashFailed, FlashInterrupted, Refused
 from mercmac.upload.plan import Action, Plan, Step, make_plan
-from mercmac.upload.connect import Identity, refusal
+from mercmac.upload.connect import Identity, check_model, identify, open_controller, refusal
+from mercmac.upload.transport import DEFAULT_BAUD, Timing
 
 CLEANUP_TIMEOUT = 0.5  # s: after Ctrl-C, how long one tidy-up read may take
 
@@ -63,8 +67,67 @@ class FlashResult:
             out.append((protocol.command(step.wire), step.describe))
             out.append((protocol.command(step.readback), f"read back {step.name}"))
         if self.reset:
-            out.append((protocol.command("RT"), "reset: macro 0 starts"))
+            out.append((protocol.command(mdtext.rt()), "reset: macro 0 starts"))
         return out
+
+
+class Watch:
+    """What `flash_file` tells its caller, in order; each part does nothing unless overridden."""
+
+    def refused(self, compilation: Compilation) -> None:
+        """The file has errors (for the controller's model): shown before the refusal."""
+
+    def identified(self, identity: Identity, warning: str | None) -> None:
+        """The controller answered and fits the program; `warning`: it does not (--force)."""
+
+    @contextmanager
+    def writing(self) -> Iterator[Notify]:
+        """Around the backup, the writes and their verification; yields where events go."""
+        yield lambda event: None
+
+    def finished(self, result: FlashResult) -> None:
+        """The flash is complete; the port is still open (closing it may yet be cut short)."""
+
+
+def flash_file(port: str, path: str, *, address: int = 0, baud: int = DEFAULT_BAUD,
+               timing: Timing = Timing(), options: FlashOptions | None = None,
+               target: str | None = None, force: bool = False,
+               watch: Watch | None = None) -> FlashResult:
+    """Flash the .mcm file PATH to the controller at `address` on PORT (SPEC §4).
+
+    A file without `target` (and no `target` given) is compiled again for the model
+    that answers, so that it is checked against that controller; a model other than
+    the program's is refused unless `force`. Refused, FlashFailed, FlashInterrupted or
+    PortError say what happened; backup.BackupError: `options.backup` cannot be written
+    (checked before the port is opened); OSError: the file cannot be read.
+    """
+    watch = watch or Watch()
+    options = options or FlashOptions()
+    program = _compile(path, target, watch)
+    if options.backup is not None:
+        backup.check(options.backup)  # a device, FIFO or folder: refused before the port opens
+    with open_controller(port, address, baud=baud, timing=timing) as c:
+        try:
+            who = identify(c)
+            if program.target is None:
+                program = _compile(path, who.version.model, watch)
+            watch.identified(who, check_model(who, program.target, path, force=force))
+        except KeyboardInterrupt:
+            raise FlashInterrupted("interrupted before the first write; nothing was written") from None
+        with watch.writing() as notify:
+            result = flash(c, who, program, options, notify)
+            watch.finished(result)
+    return result
+
+
+def _compile(path: str, target: str | None, watch: Watch) -> Program:
+    """The program of PATH for `target`; Refused (after `watch.refused`) if it has errors."""
+    compilation = compile_file(path, target=target)
+    if compilation.report.has_errors or compilation.program is None:
+        watch.refused(compilation)
+        against = f" for the {target}" if target else ""
+        raise Refused(f"{path} has errors{against}; nothing was flashed")
+    return compilation.program
 
 
 def flash(controller: Controller, identity: Identity, program: Program,

@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import Enum
 
+from mercmac import mdtext
 from mercmac.compiler.program import Program
 from mercmac.upload import protocol
 
@@ -34,8 +35,8 @@ class Step:
     def wire(self) -> str:
         """The command line sent, without CR."""
         if self.action is Action.WRITE:
-            return f"MD{self.slot},{self.line}"
-        return "RZ" if self.slot == 0 else f"RM{self.slot}"
+            return mdtext.md(self.slot, self.line)
+        return mdtext.remove(self.slot)
 
     @property
     def describe(self) -> str:
@@ -52,7 +53,7 @@ class Step:
     @property
     def readback(self) -> str:
         """The command that reads the slot back (`TM0` would list all but 0)."""
-        return "TZ" if self.slot == 0 else f"TM{self.slot}"
+        return mdtext.tell(self.slot)
 
 
 class Fate(str, Enum):

@@ -1,14 +1,15 @@
 """The Mercury serial protocol as pure bytes: framing, address codes, report parsing.
 
 Nothing here touches a port. The transport feeds received bytes to a
-`ReportSplitter`; the controller layer builds lines with `select` and
-`command` and reads replies with the `parse_*` functions (SPEC §4).
+`ReportSplitter`; the controller layer frames the lines mercmac.mdtext builds
+with `select` and `command` and reads replies with the `parse_*` functions (SPEC §4).
 """
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass
 
+from mercmac import mdtext
 from mercmac.commands import MODELS
 
 SELECT = 0x01  # MS176E §3.1.1: first character of the address selection code (Ctrl-A)
@@ -101,32 +102,46 @@ def quote(report: str, limit: int = 80) -> str:
 
 @dataclass(frozen=True, slots=True)
 class Version:
-    """What `VE` says: the model, the firmware version and the whole text."""
+    """What `VE` says: the model (None when it names none mercmac knows), the firmware
+    version ('?' when it gives none) and the whole text."""
 
-    model: str
+    model: str | None
     firmware: str
     text: str
 
     @property
+    def name(self) -> str:
+        """The model for people: 'C-863', or 'unknown model'."""
+        return self.model or "unknown model"
+
+    @property
     def char_gap_limited(self) -> bool:
-        """Firmware 1.xx drops characters more than 20 ms apart (MS176E §2 notes)."""
-        return self.firmware.startswith("1.")
+        """Firmware 1.xx drops characters more than 20 ms apart (MS176E §2 notes); an
+        unknown version is taken to be that old."""
+        return self.firmware.startswith("1.") or self.firmware == UNKNOWN_FIRMWARE
 
 
 _MODEL = re.compile(r"\bC-?(\d{3})\b", re.IGNORECASE)
 _FIRMWARE = re.compile(r"\bVer(?:sion)?\.?\s*(\d+(?:\.\d+)*)", re.IGNORECASE)
+_MAKER = re.compile(r"Physik\s*Instrumente", re.IGNORECASE)  # §6.4 VE: the copyright notice
+UNKNOWN_FIRMWARE = "?"
 
 
 def parse_version(report: str) -> Version:
-    """Model and firmware from a VE report; ProtocolError when it is not one."""
+    """Model and firmware from a VE report; ProtocolError when it is not one.
+
+    A report with a version number or PI's copyright notice is a version report even
+    when it names no model mercmac knows: older firmware and the C-862 predecessor may
+    answer so, and the caller decides (connect.check_model); the model is None then.
+    """
     text = " ".join(lines(report))
     found = [f"C-{m}" for m in _MODEL.findall(text)]
     model = next((m for m in found if m in MODELS), None)
     firmware = _FIRMWARE.search(text)
-    if model is None or firmware is None:
-        raise ProtocolError("not a version report (expected a model such as C-863 and "
-                            "'Ver. n.nn', MS176E §6.4 VE)", report)
-    return Version(model, firmware.group(1), text)
+    if firmware is None and not _MAKER.search(text):
+        raise ProtocolError("not a version report (expected PI's notice, a model such as "
+                            "C-863 and 'Ver. n.nn', MS176E §6.4 VE)", report)
+    return Version(model, firmware.group(1) if firmware else UNKNOWN_FIRMWARE, text)
 
 
 def is_version(report: str) -> bool:
@@ -208,26 +223,15 @@ def parse_macros(report: str) -> dict[int, str]:
     return {slot: text for slot, text in found.items() if text}
 
 
-def canonical(line: str) -> str:
-    """A macro as the controller may store it: upper case, no spaces, no '+' or leading 0s.
-
-    SPEC §4: compare macros as the controller may store them; MMCRun files
-    write `EM+9` (MS176E §3.8.6, Example 4) where mercmac sends `EM9`.
-    """
-    text = re.sub(r"\s+", "", line.upper())
-    text = re.sub(r"(?<=[A-Z?])\+", "", text)
-    text = re.sub(r"(?<![0-9])0+(?=[0-9])", "", text)
-    return text.rstrip(",")
-
-
 def same_macro(a: str | None, b: str | None) -> bool:
-    """Whether two stored lines mean the same; None is an empty slot."""
-    return canonical(a or "") == canonical(b or "")
+    """Whether two stored lines mean the same; None is an empty slot. SPEC §4: compare as
+    the controller may store them (MMCRun files write `EM+9` where mercmac sends `EM9`)."""
+    return mdtext.normal(a) == mdtext.normal(b)
 
 
 def difference(expected: str | None, got: str | None) -> str:
     """How a read-back differs from what was sent, for a person."""
-    want, have = canonical(expected or ""), canonical(got or "")
+    want, have = mdtext.normal(expected), mdtext.normal(got)
     if not have:
         return f"expected {want!r}, the slot reads back empty"
     if not want:

@@ -47,7 +47,7 @@ class Found:
     @property
     def model(self) -> str:
         if self.version:
-            return self.version.model
+            return self.version.name
         return self.status.layout if self.status else "?"
 
 

@@ -1,6 +1,8 @@
 """The controller's clock: integer microseconds and the command cycle (SPEC §3 Time)."""
 from __future__ import annotations
 
+from mercmac.vm import fastforward as ff
+
 
 class CycleError(ValueError):
     """A command cycle the clock cannot count in (not finite, or outside 1 us to 1 s)."""
@@ -8,6 +10,10 @@ class CycleError(ValueError):
 
 class Clock:
     """Now, in us since power-on, and how long one executed command takes."""
+
+    STATE_KEY = ("cycle",)  # fastforward.key_fields
+    NOT_KEYED = {"now": "the clock itself: passes are compared at different times"}
+    state_key = ff.key_fields(*STATE_KEY)
 
     def __init__(self, cycle_ms: float = 1.0):
         # bounded before rounding: round() fails on nan and inf, and 1e308 ms * 1000 is inf
@@ -21,3 +27,4 @@ class Clock:
     @property
     def now_ms(self) -> float:
         return self.now / 1000
+

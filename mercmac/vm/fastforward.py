@@ -19,12 +19,29 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Iterator
+from enum import Enum
+from operator import attrgetter
+from typing import Iterator, NamedTuple
 
 from mercmac.vm import events as ev
 
 REPORT, OUTPUTS, SKIP = "report", "outputs", "skip"  # what a shape's items are
 FLOW = (ev.MacroEntered, ev.MacroLeft, ev.Executed)  # control flow: repeats with the pass
+
+
+class Loop(Enum):
+    """What brings a loop round to its anchor."""
+
+    EM = "em"  # a macro entered by EM (a macro that calls itself, or a ring of gotos)
+    RP = "rp"  # an RP that jumps back to the start of its macro
+
+
+class Anchor(NamedTuple):
+    """Where a loop comes round: a macro's entry, or one RP in it."""
+
+    loop: Loop
+    slot: int
+    ip: int = 0  # the RP's place; 0 for a macro's entry
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,9 +60,9 @@ class Anchors:
     """The last visit of every loop anchor."""
 
     def __init__(self):
-        self.visits: dict[tuple, Visit] = {}
+        self.visits: dict[Anchor, Visit] = {}
 
-    def arrive(self, anchor: tuple, visit: Visit) -> Visit | None:
+    def arrive(self, anchor: Anchor, visit: Visit) -> Visit | None:
         """Record a visit; return the previous one if it bounds a pass."""
         previous = self.visits.get(anchor)
         self.visits[anchor] = visit
@@ -53,14 +70,31 @@ class Anchors:
 
     def forget_slot(self, slot: int) -> None:
         """A macro was entered: its RP counters restart, so its loop visits are void."""
-        for anchor in [a for a in self.visits if a[0] == "rp" and a[1] == slot]:
+        for anchor in [a for a in self.visits if a.loop is Loop.RP and a.slot == slot]:
             del self.visits[anchor]
 
-    def forget(self, anchor: tuple) -> None:
+    def forget(self, anchor: Anchor) -> None:
         self.visits.pop(anchor, None)
 
     def clear(self) -> None:
         self.visits.clear()
+
+
+def key_fields(*names: str):
+    """A part's `state_key()`: its fields `names`, what decides its future, as a tuple.
+
+    Each part lists every field either there (its STATE_KEY) or in NOT_KEYED with the
+    reason it may be left out; tests/test_vm_surface.py fails when a field is in neither,
+    and when a keyed field holds a mutable value (a key must not change with the part).
+    """
+    get = attrgetter(*names)
+    if len(names) == 1:
+        def state_key(part) -> tuple:
+            return (get(part),)
+    else:
+        def state_key(part) -> tuple:
+            return get(part)
+    return state_key
 
 
 def logged(event) -> bool:

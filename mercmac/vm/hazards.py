@@ -1,16 +1,66 @@
-"""Hazards: what would hurt on the bench, reported once per rule and instruction."""
+"""Hazards: what would hurt on the bench, reported once per rule and instruction.
+
+Each is a `Rule` like the checks of `mercmac.diagnostics`, with a stable code
+(MHnnn) and its story, so that `mercmac explain MH004` / `explain hard-limit`
+shows it; the simulator reports each with time and source line.
+"""
 from __future__ import annotations
 
-# rule -> what it means; the simulator reports each with time and source line.
-RULES = {
-    "move-servo-off": "a move was commanded while the servo is off (MF): error 0A, §6.4 TS",
-    "move-joystick-on": "a move was commanded while the joystick is on: refused, error 0B, §6.4 MA",
-    "soft-limit-clamp": "the target lies beyond a soft limit and was clamped to it, §4.4.2",
-    "hard-limit": "the stage ran into a limit switch and stopped abruptly, §4.4.1",
-    "ws-never-finishes": "WS waits for an on-target state the profile never reaches (SV0/SA0)",
-    "busy-loop": "a long loop repeats without any wait, at the full command rate",
-    "reference-not-found": "FE searches away from the reference switch, §6.4 FE",
-}
+from mercmac.diagnostics import Rule, Severity
+
+_W = Severity.WARNING
+
+RULES: tuple[Rule, ...] = (
+    Rule("MH001", "move-servo-off", _W, "a move was commanded while the servo is off (MF)", """\
+With the servo off (MF) the controller does not drive the motor: the stage
+neither holds its position nor moves, and the C-863 refuses the move with
+error 0A "Servo off" in the TS report (MS176E §6.4 TS, MN/MF). The manual's
+stand-alone examples never send MN, so whether the servo is on at power-on is
+a simulator option (`sim --servo-off`); on the bench it depends on the
+controller's settings. Send MN before the first move, e.g. at the start of
+the autostart macro."""),
+    Rule("MH002", "move-joystick-on", _W, "a move was commanded while the joystick is on", """\
+While a joystick axis is enabled (JN) the controller refuses motion commands
+(MA, MR, GH, FE, ...) with error 0B (MS176E §3.6.1, §6.4 MA): the macro runs on
+but the stage does not go where the macro says. Send JF before the move and
+JN again after it, or keep joystick and macro moves in different modes
+(Example 4 switches with EM)."""),
+    Rule("MH003", "soft-limit-clamp", _W, "a target beyond a soft limit was clamped to it", """\
+The soft limits set with JH and JL (MS176E §4.4.2) clamp every target: a move
+beyond them ends at the limit instead, so the position the macro expects and
+the one the stage reaches differ, and everything after it (reports, relative
+MR moves) is off by the difference. Move within the limits, widen them with
+JH/JL, or clear them with JC if the travel allows."""),
+    Rule("MH004", "hard-limit", _W, "the stage ran into a limit switch and stopped abruptly", """\
+The stage reached a limit switch of the travel range (MS176E §4.4.1): the
+controller stops the motor at once, without the deceleration ramp, and sets
+error 07 in the TS report. That is hard on the mechanics and the load, and
+the target was not reached. Keep targets inside the travel (the simulator
+places the switches with `sim --hard-limits NEG,POS`), or set soft limits
+with JH/JL so that moves stop in time."""),
+    Rule("MH005", "ws-never-finishes", _W, "WS waits for an on-target state the profile never reaches", """\
+WS waits until the move is finished, then n ms (MS176E §6.4 WS). With a
+programmed velocity SV0 or acceleration SA0 the profile never reaches its
+target, so the macro hangs in WS for good and nothing after it runs. Set SV
+and SA before the move (power-on defaults: C-863 SV 45000, SA 400000; C-663
+SV 20000, SA 250000, §3.4), or use WA to wait a fixed time."""),
+    Rule("MH006", "busy-loop", _W, "a long loop repeats without any wait, at the full command rate", """\
+A loop (RP, or macros that call each other round) that runs many passes
+without WA, WS, WN or WF executes at the full command rate, one command per
+controller cycle (SPEC §3). A polling loop like that keeps the controller
+busy, floods the host with any reports it makes, and on a bench usually means
+a missing wait. Add a WA of a few ms to each pass (`every 20ms { ... }` does
+this for you)."""),
+    Rule("MH007", "reference-not-found", _W, "FE searches away from the reference switch", """\
+FE starts a reference (home) search in the direction its argument gives
+(MS176E §6.4 FE, §4.3). When the reference switch lies the other way, the
+stage runs to the end of its travel and stops at the limit switch without
+having found the reference, so every later absolute move is off. Use the
+other fixed direction (FE0 / FE1), or FE2 / FE3, which pick the direction from
+the switch state. The simulator places the switch with `sim --reference-at`."""),
+)
+
+NAMES = frozenset(r.name for r in RULES)
 
 
 class HazardLog:
@@ -21,7 +71,7 @@ class HazardLog:
 
     def first(self, rule: str, where_key: tuple) -> bool:
         """True the first time this rule fires at this place."""
-        if rule not in RULES:
+        if rule not in NAMES:
             raise KeyError(f"unknown hazard rule {rule}")
         key = (rule, where_key)
         if key in self.seen:

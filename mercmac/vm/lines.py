@@ -4,6 +4,8 @@ from __future__ import annotations
 import heapq
 import math
 
+from mercmac.vm import fastforward as ff
+
 INPUTS = range(1, 7)  # 1-4 pushbuttons, 5 joystick (ON above mid-scale), 6 joystick button
 
 
@@ -57,6 +59,14 @@ class Inputs:
 class Outputs:
     """Four digital outputs; output 4 also carries trigger pulses (§4.5.2)."""
 
+    STATE_KEY = ("set_bits",)  # fastforward.key_fields
+    NOT_KEYED = {
+        # a time: a pulse still on bounds a skip as a hardware event (Machine._next_hardware),
+        # and one that ended shows nothing
+        "pulse_until": "when the trigger pulse on output 4 ends",
+    }
+    state_key = ff.key_fields(*STATE_KEY)
+
     def __init__(self):
         self.set_bits = 0  # what CN/CF/CP programmed
         self.pulse_until = -math.inf  # output 4 is high for a trigger pulse until then
@@ -64,3 +74,4 @@ class Outputs:
     def pattern(self, t_us: float) -> int:
         """The 4-bit pattern the LEDs show at t_us (bit 0 = output 1, §6.4 CP)."""
         return self.set_bits | (8 if t_us < self.pulse_until else 0)
+

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from enum import Enum
 from typing import Callable, Iterable
 
 from mercmac.commands import C663, COMMANDS, MAX_POSITION
@@ -19,7 +20,7 @@ from mercmac.vm import reports
 from mercmac.vm.assemble import DIRECT, Chunk, assemble, assemble_ops
 from mercmac.vm.clock import Clock
 from mercmac.vm.disasm import instruction
-from mercmac.vm.fastforward import Anchors, Visit, same_pass, skippable
+from mercmac.vm.fastforward import Anchor, Anchors, Loop, Visit, same_pass, skippable
 from mercmac.vm.hazards import HazardLog
 from mercmac.vm.lines import Inputs, Outputs
 from mercmac.vm.models import DEFAULTS, Options, model_name
@@ -35,6 +36,14 @@ FAST_FORWARD = ("off", "quiet", "all")  # skip no passes, passes that emit nothi
 
 # §6.4 TS error codes
 E_WRONG_COMMAND, E_HARD_STOP, E_SERVO_OFF, E_JOYSTICK = 0x06, 0x07, 0x0A, 0x0B
+
+
+class Wait(Enum):
+    """What a blocked wait command waits for (§6.4 WS, WN, WF)."""
+
+    WS = "WS"  # the move to end (on target), then n ms
+    WN = "WN"  # input n ON
+    WF = "WF"  # input n OFF
 
 
 @dataclass(slots=True)
@@ -54,6 +63,33 @@ class Hardware:
 
 class Machine:
     """A Mercury controller running stored macros and direct-mode lines."""
+
+    # Fast-forward compares this state at each loop anchor (`_state_key`). Every field is
+    # here or in NOT_KEYED with the reason it may be left out; tests/test_vm_surface.py
+    # fails when a new field is in neither, which would make a skip silently inexact.
+    STATE_KEY = ("chunk", "ip", "ret", "block", "counters", "last_rp", "params", "error",
+                 "brake", "limits_on", "limits_high", "shown", "mover",
+                 "clock", "outputs", "axis", "trigger")  # the parts: their own state_key()
+    NOT_KEYED = {
+        "model": "fixed for the machine's life",
+        "options": "fixed for the machine's life",
+        "on_report": "the observer, not the machine",
+        "on_event": "the observer, not the machine",
+        "trace": "what the observer hears, not what the machine does",
+        "fast_forward": "how far to skip, not what a pass does",
+        "_log": "fast-forward's own record of what passes emitted (Visit.shape)",
+        "_log_base": "fast-forward's own record of what passes emitted (Visit.shape)",
+        "anchors": "fast-forward's own record of the visits",
+        "_horizon": "the end of the run: it bounds a skip (skippable)",
+        "chunks": "the stored macros: load, define and RM/RZ clear the anchors",
+        "inputs": "compared on their own: Visit.inputs counts the changes, and scheduled "
+                  "ones bound a skip (_next_hardware)",
+        "wake": "the clock: Visit.wake, from which the period of a pass comes",
+        "waits": "compared on their own: Visit.waits (busy-loop hazard)",
+        "hazards": "each is reported once: one in a pass makes its shape unrepeatable",
+        "table_done": "a time: inf unless a JT table is being made, and then it bounds a "
+                      "skip as a hardware event (_next_hardware)",
+    }
 
     def __init__(self, program: Program | None = None, *, model: str | None = None,
                  cycle_ms: float = 1.0, options: Options | None = None,
@@ -132,9 +168,47 @@ class Machine:
         return self.clock.now_ms
 
     @property
+    def now_us(self) -> int:
+        return self.clock.now
+
+    @property
+    def cycle_ms(self) -> float:
+        """How long one executed command takes (SPEC §3 Time)."""
+        return self.clock.cycle / 1000
+
+    @property
     def macro(self) -> int | None:
         """The running macro's number; None in direct mode or when a typed line runs."""
         return None if self.chunk is None or self.chunk.slot == DIRECT else self.chunk.slot
+
+    @property
+    def label(self) -> str | None:
+        """What runs: 'main (MC05)', 'MC05', 'direct' for a typed line; None when nothing does."""
+        return None if self.chunk is None else self.chunk.label
+
+    def stored_macros(self) -> dict[int, str]:
+        """The stored command lines by macro number, as TM lists them: {5: 'MR5000,WS100'}."""
+        return {slot: chunk.line for slot, chunk in sorted(self.chunks.items())}
+
+    def setting(self, name: str) -> int:
+        """The value a setting command stored (DP, FM, SM, ...; §6.2); 0 if it has none."""
+        return self.params.get(name, 0)
+
+    def set_error(self, code: int) -> None:
+        """Record the error code that TS reports (§6.4 TS), as the serial front end does."""
+        self.error = code
+
+    def take_self_select(self) -> int | None:
+        """The address an SCn in macro 0 selected since the last call (§3.1.2), once."""
+        return self.params.pop("SC", None)
+
+    def input(self, n: int) -> bool:
+        """Whether input line n (1-6) is ON."""
+        return self.inputs[n]
+
+    def input_lines(self) -> tuple[bool, ...]:
+        """Inputs 1-6 by number (index 0 is unused, as the lines count from 1)."""
+        return tuple(self.inputs.state)
 
     def position(self) -> int:
         return round(self.axis.position(self.clock.now))
@@ -146,12 +220,29 @@ class Machine:
     def velocity(self) -> int:
         return round(self.axis.velocity(self.clock.now))
 
+    def moving(self) -> bool:
+        """Whether the axis moves (or is stuck trying to: SV0 or SA0) now."""
+        return self.axis.moving(self.clock.now)
+
     def outputs_pattern(self) -> int:
         return self.outputs.pattern(self.clock.now)
 
     def status(self) -> str:
-        """The TS report (§6.4 TS)."""
+        """The TS report (§6.4 TS), without reading it: the error code stays."""
         return reports.status(self)
+
+    def read_status(self) -> str:
+        """TS or `%` as the firmware answers it: the report, after which the error code is 00.
+
+        MS176E is silent on when the error code of §6.4 TS (block 6, C-663 block 3)
+        clears, and has no command that clears it; so reading it does, as ERR? ("get the
+        error code ... and reset the error to 0") does in the GCS command set (MS163E)
+        that these controllers also speak (§1.1). A code that never cleared would make
+        every later TS report an old mistake.
+        """
+        text = reports.status(self)
+        self.error = 0
+        return text
 
     def iteration(self) -> int:
         """TI: the counter of the RP that last jumped in the running macro, else 0 (SPEC §3)."""
@@ -160,6 +251,15 @@ class Machine:
         slot = self.chunk.slot
         ip = self.last_rp.get(slot)
         return self.counters.get(slot, {}).get(ip, 0)
+
+    def next_command_ms(self) -> float:
+        """When the running line or macro executes its next command; inf while it waits for
+        a move or an input line, when nothing runs, and when all that is left is to end."""
+        if self.chunk is None or self.block is not None:
+            return INF
+        if self.ip >= len(self.chunk.code) and self.ret is None:
+            return INF  # no return point: the program just ends (§3.8.4)
+        return self.wake / 1000
 
     def next_event_ms(self) -> float:
         """When the next hardware event or command is due; inf when nothing will happen."""
@@ -281,6 +381,8 @@ class Machine:
                 self._joystick_table(arg)
             case Opcode.SET:
                 self.params[arg[0]] = arg[1] if arg[1] is not None else COMMANDS[arg[0]].default or 0
+            case Opcode.REPORT if arg[0] == "TS":
+                self._report(self.read_status())
             case Opcode.REPORT:
                 self._report(reports.report(arg[0], arg[1], self))
             case Opcode.RT:
@@ -303,7 +405,7 @@ class Machine:
         self.last_rp.pop(slot, None)
         self.anchors.forget_slot(slot)
         self._emit(ev.MacroEntered(self.clock.now, slot, self.chunk.label, via))
-        self._loop_anchor(("em", slot), None, INF)
+        self._loop_anchor(Anchor(Loop.EM, slot), None, INF)
 
     def _call(self, slot: int) -> None:
         """EMn: the ONE return point becomes 'after this EM' (§3.8.4); n empty: nothing."""
@@ -329,12 +431,12 @@ class Machine:
         left = counters[ip] - 1 if ip in counters else n
         if left <= 0:
             counters.pop(ip, None)
-            self.anchors.forget(("rp", slot, ip))
+            self.anchors.forget(Anchor(Loop.RP, slot, ip))
             return
         counters[ip] = left
         self.last_rp[slot] = ip
         self.ip = 0
-        self._loop_anchor(("rp", slot, ip), ip, left - 1)
+        self._loop_anchor(Anchor(Loop.RP, slot, ip), ip, left - 1)
 
     # ---------------------------------------------------------------- waits
     def _wait_stop(self, n: int) -> None:
@@ -345,7 +447,7 @@ class Machine:
                          f"WS waits for a move that never ends: SV is {self.axis.sv}, "
                          f"SA is {self.axis.sa}")
         if self.axis.moving(self.clock.now):
-            self.block = ("WS", n, self.clock.now)
+            self.block = (Wait.WS, n, self.clock.now)
         else:
             self.wake = self.clock.now + max(n * 1000, self.clock.cycle)
 
@@ -353,12 +455,12 @@ class Machine:
         """WNn / WFn: until input n is ON / OFF (§6.4 WN, WF)."""
         self.waits += 1
         if self.inputs.state[n] != on:
-            self.block = ("WN" if on else "WF", n, self.clock.now)
+            self.block = (Wait.WN if on else Wait.WF, n, self.clock.now)
 
     def _unblock(self, t: int) -> None:
         """A wait ends at t; the next command runs then, one cycle after the wait at least."""
         kind, value, began = self.block
-        extra = value * 1000 if kind == "WS" else 0
+        extra = value * 1000 if kind is Wait.WS else 0
         self.wake = max(t + extra, began + self.clock.cycle)
         self.block = None
 
@@ -502,8 +604,8 @@ class Machine:
     def _input_changed(self, n: int, on: bool) -> None:
         t = self.clock.now
         self._emit(ev.InputChanged(t, n, on))
-        if self.block and self.block[0] in ("WN", "WF") and self.block[1] == n:
-            if on == (self.block[0] == "WN"):
+        if self.block and self.block[0] in (Wait.WN, Wait.WF) and self.block[1] == n:
+            if on == (self.block[0] is Wait.WN):
                 self._unblock(t)
         if n == 5 and self.axis.joystick:
             self._drive_joystick()
@@ -522,11 +624,11 @@ class Machine:
             self._hazard("hard-limit", f"the stage hit the {happened[1]} limit switch at "
                          f"{round(self.axis.final)} and stopped abruptly", where=self.mover)
         self._emit(ev.MoveEnded(t, happened[0], round(self.axis.final)))
-        if self.block and self.block[0] == "WS":
+        if self.block and self.block[0] is Wait.WS:
             self._unblock(t)
 
     # ---------------------------------------------------------------- fast-forward
-    def _loop_anchor(self, anchor: tuple, own: int | None, remaining: float) -> None:
+    def _loop_anchor(self, anchor: Anchor, own: int | None, remaining: float) -> None:
         """A loop came round: report a busy loop, skip identical passes (fastforward.py)."""
         previous = self.anchors.visits.get(anchor)
         key = self._state_key(own)
@@ -542,12 +644,12 @@ class Machine:
         if passes > 0:
             self._skip(anchor, own, passes, visit.wake - previous.wake, visit)
 
-    def _busy_loop(self, anchor: tuple, key: tuple | None, previous: Visit,
+    def _busy_loop(self, anchor: Anchor, key: tuple | None, previous: Visit,
                    remaining: float) -> None:
         """Report a long loop without waits, once; it ends the pass, so that pass is not
         skipped (a loop is skipped after two passes without a new hazard, as plain
         stepping would report none in the passes skipped)."""
-        looped = anchor[0] == "rp" or (key is not None and key == previous.key)
+        looped = anchor.loop is Loop.RP or (key is not None and key == previous.key)
         if looped and self.waits == previous.waits and remaining >= BUSY_PASSES:
             self._hazard("busy-loop", f"{self.chunk.label} loops without a wait: it runs at "
                          f"the full command rate; add WA", where=self._where_anchor(anchor))
@@ -564,7 +666,7 @@ class Machine:
         return Visit(key, self.wake, self.inputs.version, self.waits,
                      self._log_base + len(self._log), pass_shape)
 
-    def _skip(self, anchor: tuple, own: int | None, passes: int, period: int,
+    def _skip(self, anchor: Anchor, own: int | None, passes: int, period: int,
               visit: Visit) -> None:
         """Skip `passes` copies of the pass that ended at `visit`; the clock jumps exactly."""
         start = self.wake
@@ -581,18 +683,21 @@ class Machine:
                                           self._log_base + len(self._log), visit.shape))
 
     def _state_key(self, own: int | None) -> tuple | None:
-        """The whole machine state except the clock and the jumping RP's own counter."""
+        """The whole machine state except the clock and the jumping RP's own counter
+        (STATE_KEY); None while the axis moves."""
         if self.axis.moving(self.clock.now) or self.axis.segs:
             return None
+        # written out, in STATE_KEY's order, as it runs at every anchor; the chunks are
+        # replaced only by load, define and RM, which clear the anchors: a slot stands for one
         slot = self.chunk.slot
         counters = tuple((s, tuple((ip, c) for ip, c in sorted(cs.items())
                                    if not (s == slot and ip == own)))
                          for s, cs in sorted(self.counters.items()))
         ret = (self.ret[0].slot, self.ret[1]) if self.ret else None
-        return (slot, self.ip, ret, counters, tuple(sorted(self.last_rp.items())),
-                self.outputs.set_bits, self.axis.idle_key(), self.trigger.key(),
+        return (slot, self.ip, ret, self.block, counters, tuple(sorted(self.last_rp.items())),
                 tuple(self.params.items()), self.error, self.brake, self.limits_on,
-                self.limits_high)
+                self.limits_high, self.shown, self.mover, self.clock.state_key(),
+                self.outputs.state_key(), self.axis.state_key(), self.trigger.state_key())
 
     # ---------------------------------------------------------------- bookkeeping
     def _reset_state(self) -> None:
@@ -618,10 +723,9 @@ class Machine:
             return None
         return ev.Where(chunk.label, chunk.slot, ip, chunk.spans[ip])
 
-    def _where_anchor(self, anchor: tuple) -> ev.Where:
-        slot = anchor[1]
-        chunk = self.chunks.get(slot, self.chunk)
-        ip = anchor[2] if anchor[0] == "rp" else 0
+    def _where_anchor(self, anchor: Anchor) -> ev.Where:
+        chunk = self.chunks.get(anchor.slot, self.chunk)
+        ip = anchor.ip
         span = chunk.spans[ip] if ip < len(chunk.spans) else None
         return ev.Where(chunk.label, chunk.slot, ip, span)
 

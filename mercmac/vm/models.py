@@ -46,6 +46,7 @@ class Options:
     reference_at: int = 0  # position of the reference switch edge (SPEC §3, §4.3)
     hard_limits: tuple[int, int] | None = None  # (negative, positive) limit switch positions
     address: int = 0  # DIP switches 1-4, what TB reports (§6.4 TB)
+    firmware: str = "2.30"  # the version VE reports (§6.4 VE example: "Ver. 2.30")
 
 
 def model_name(name: str | None) -> str:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 from mercmac.commands import MAX_POSITION
+from mercmac.vm import fastforward as ff
 from mercmac.vm.models import Defaults, Options
 from mercmac.vm.trapezoid import PER_S, PER_S2, Segment, plan, stop
 
@@ -19,13 +20,22 @@ INF = math.inf
 class Axis:
     """One motor axis with a trapezoidal profile generator."""
 
+    # fast-forward's state key (fastforward.key_fields): everything that decides future motion
+    STATE_KEY = ("segs", "final", "target", "shift", "sv", "sa", "jh", "jl", "servo",
+                 "joystick", "homing", "referenced", "stalled", "edge_ahead", "negative", "limit")
+    NOT_KEYED = {
+        "defaults": "the model's power-on values: fixed for the axis's life",
+        "options": "bench facts (switch positions, servo at power-on): fixed for the axis's life",
+    }
+    state_key = ff.key_fields(*STATE_KEY)
+
     def __init__(self, defaults: Defaults, options: Options):
         self.defaults, self.options = defaults, options
         self.reset()
 
     def reset(self) -> None:
         """Power-on state: position 0 (§3.5.1: "upon power-on ... set to zero")."""
-        self.segs: list[Segment] = []
+        self.segs: tuple[Segment, ...] = ()  # a tuple: replaced, never changed in place
         self.final = 0.0  # where the axis rests once segs are done
         self.target = 0
         self.shift = 0.0  # coordinates = physical position + shift (DH)
@@ -75,11 +85,6 @@ class Axis:
         p = self.position(t) - self.shift
         return "positive" if p >= hi else "negative" if p <= lo else None
 
-    def idle_key(self) -> tuple:
-        """Everything that decides future motion, when no profile runs (fast-forward)."""
-        return (self.final, self.target, self.shift, self.sv, self.sa, self.jh, self.jl,
-                self.servo, self.joystick, self.homing, self.referenced, self.stalled,
-                self.edge_ahead, self.negative)
 
     # -- commanding it --
     def move(self, t: float, target: int, vmax: float | None = None) -> None:
@@ -89,9 +94,9 @@ class Axis:
         speed = (self.sv if vmax is None else vmax) * PER_S
         self.stalled = x != target and (speed <= 0 or self.sa <= 0)
         if self.stalled:  # SV0 or SA0: the profile never gets anywhere
-            self.segs, self.final = [], x
+            self.segs, self.final = (), x
             return
-        self.segs = plan(t, x, v, target, speed, self.sa * PER_S2)
+        self.segs = tuple(plan(t, x, v, target, speed, self.sa * PER_S2))
         self.final = float(target)
         if self.segs:
             self.negative = self.segs[-1].v0 < 0
@@ -100,14 +105,14 @@ class Axis:
     def halt(self, t: float) -> None:
         """AB: profile velocity zero at once, target := position (§6.4 AB)."""
         self.final = self.position(t)
-        self.segs, self.stalled, self.homing, self.limit = [], False, False, None
+        self.segs, self.stalled, self.homing, self.limit = (), False, False, None
         self.target = round(self.final)
 
     def decelerate(self, t: float) -> None:
         """AB1: decelerate with SA; the target becomes the stop point (SPEC §3)."""
         if self.sa <= 0:
             return self.halt(t)
-        self.segs = stop(t, self.position(t), self.velocity(t) * PER_S, self.sa * PER_S2)
+        self.segs = tuple(stop(t, self.position(t), self.velocity(t) * PER_S, self.sa * PER_S2))
         self.final = self.segs[-1].x(self.segs[-1].t1) if self.segs else self.position(t)
         self.target, self.stalled, self.homing = round(self.final), False, False
         self._find_limit()
@@ -116,7 +121,7 @@ class Axis:
         """DH: the present position becomes `value`, target shifted alike (SPEC §3)."""
         delta = value - self.position(t)
         self.shift += delta
-        self.segs = [Segment(s.t0, s.x0 + delta, s.v0, s.a, s.dt) for s in self.segs]
+        self.segs = tuple(Segment(s.t0, s.x0 + delta, s.v0, s.a, s.dt) for s in self.segs)
         self.final += delta
         self.target = round(self.target + delta)
 
@@ -171,7 +176,7 @@ class Axis:
             self.target = round(self.final)
             return ("limit", side)
         if self.segs and self.arrival() <= t:
-            self.segs = []
+            self.segs = ()
             self.referenced = self.referenced or (self.homing and self.edge_ahead)
             self.homing = False
             return ("arrived", self.final)

@@ -14,7 +14,7 @@ if TYPE_CHECKING:
 
 # §6.4 CS and VE examples; the model name in VE is how a host tells C-663 from C-863.
 CHECKSUM = "C:0230-15"
-VERSION = "(c)2009 Physik Instrumente(PI) Karlsruhe, {model}, Ver. 2.30, 2009-21-07"
+VERSION = "(c)2009 Physik Instrumente(PI) Karlsruhe, {model}, Ver. {firmware}, 2009-21-07"
 TABLE_DONE = "Table done"  # §6.4 JT: sent when the table is generated
 
 # §6.2 "Corresponding Report Command": G* report the D* settings.
@@ -35,7 +35,7 @@ def report(mnemonic: str, arg: int | None, m: Machine) -> str:
     if mnemonic.endswith("?"):
         return _query(mnemonic, ident, m)
     if mnemonic in _GETS:
-        return number(ident, m.params.get(_GETS[mnemonic], 0))
+        return number(ident, m.setting(_GETS[mnemonic]))
     t = m.clock.now
     axis = m.axis
     match mnemonic:
@@ -68,9 +68,9 @@ def report(mnemonic: str, arg: int | None, m: Machine) -> str:
         case "CS":
             return CHECKSUM
         case "VE":
-            return VERSION.format(model=m.model)
+            return VERSION.format(model=m.model, firmware=m.options.firmware)
         case "TM":
-            return macros(m, [arg] if arg else [s for s in sorted(m.chunks) if s != 0])
+            return macros(m, [arg] if arg else [s for s in m.stored_macros() if s != 0])
         case "TZ":
             return macros(m, [0])
     raise ValueError(f"no report format for {mnemonic}")
@@ -81,7 +81,7 @@ def _query(mnemonic: str, ident: str, m: Machine) -> str:
     setting = mnemonic[:-1]
     value = {"JH": m.axis.jh, "JL": m.axis.jl, "JN": m.axis.joystick, "ZM": m.trigger.mode,
              "ZP": m.trigger.position, "ZI": m.trigger.increment}.get(setting)
-    value = m.params.get(setting, 0) if value is None else value
+    value = m.setting(setting) if value is None else value
     return f"{ident}{value}" if mnemonic in _UNSIGNED else f"{ident}{value:+d}"
 
 
@@ -114,36 +114,49 @@ def _bits(*flags: bool) -> int:
     return sum(1 << i for i, on in enumerate(flags) if on)
 
 
+def _limit_lines(m: Machine, t: float) -> tuple[bool, bool]:
+    """(negative, positive): the levels of the two limit switch lines, not whether a switch
+    is hit. §6.4 TS calls these bits "limit signal (input)" and shows them so: the C-663's
+    idle example `s:03 07 00` has both limit bits set, which only levels can be (no stage
+    sits on both switches), since PI's stepper stages switch active-low (§4.4.1 NOTE) -
+    as EPICS' drvPIC663 reads them. The C-863 example `S:04 02 00 03 02 00` (LH, §3.4.1)
+    has both clear. The stage is taken to match LH/LL, as motion needs (§4.4.1), so a
+    line is high when its switch is hit under LH and when it is not hit under LL."""
+    hit = m.axis.limit_switch(t)
+    return (hit == "negative") == m.limits_high, (hit == "positive") == m.limits_high
+
+
 def _status_863(m: Machine) -> list[int]:
     t, axis = m.clock.now, m.axis
     on_target = not axis.moving(t)
-    limit = axis.limit_switch(t)
+    negative, positive = _limit_lines(m, t)
     return [
         _bits(0, 0, on_target, axis.referenced, 0, 0, 0, not axis.servo),
-        _bits(0, True, 0, 0, m.running),  # bit 1 busy: it is executing this very TS
+        # bit 1 busy: it is executing this very TS; bit 4 a stored macro runs (a line the
+        # host typed is direct mode, §5.7, so `TS` typed alone reports 02, not 12)
+        _bits(0, True, 0, 0, m.macro is not None),
         _bits(0, 0, axis.negative),
         _bits(m.limits_on, m.limits_high, axis.homing, m.brake, axis.joystick > 0),
-        _bits(0, axis.reference_high(t), limit == "positive", limit == "negative")
-        | (m.inputs.pattern() << 4),
+        _bits(0, axis.reference_high(t), positive, negative) | (m.inputs.pattern() << 4),
         m.error,
     ]
 
 
 def _status_663(m: Machine) -> list[int]:
     t, axis = m.clock.now, m.axis
-    limit = axis.limit_switch(t)
+    negative, positive = _limit_lines(m, t)
     moving = axis.moving(t)
     macro = m.macro is not None  # a stored macro runs; a typed line (direct mode) is none
     return [
         # bit 0 Ready: set when no macro runs, as in the manual's idle `s:03 07 00` (§6.4 TS)
         _bits(not macro, not moving, axis.homing, axis.joystick > 0, macro,
               not axis.servo, m.brake, moving),
-        _bits(limit == "negative", axis.reference_high(t), limit == "positive")
-        | (m.inputs.pattern() << 4),
+        _bits(negative, axis.reference_high(t), positive) | (m.inputs.pattern() << 4),
         m.error,
     ]
 
 
 def macros(m: Machine, slots: list[int]) -> str:
     """TM/TZ: 'MC001 MR55555' per stored macro, one per line; '' when none (SPEC §4)."""
-    return "\r\n".join(f"MC{s:03d} {m.chunks[s].line}" for s in slots if s in m.chunks)
+    stored = m.stored_macros()
+    return "\r\n".join(f"MC{s:03d} {stored[s]}" for s in slots if s in stored)

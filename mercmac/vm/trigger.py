@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+from mercmac.vm import fastforward as ff
 from mercmac.vm.motion import Axis
 
 PULSE_US = 100
@@ -14,6 +15,14 @@ PULSE_US = 100
 
 class Trigger:
     """Trigger mode and positions; finds the time of the next pulse on a profile."""
+
+    STATE_KEY = ("mode", "position", "increment", "next_at", "done")  # fastforward.key_fields
+    NOT_KEYED = {
+        # a time, compared with the pulse times of a profile; the key is taken only while
+        # no profile runs, and a pass that moves never repeats
+        "last_t": "the time of the last pulse",
+    }
+    state_key = ff.key_fields(*STATE_KEY)
 
     def __init__(self):
         self.reset()
@@ -29,8 +38,6 @@ class Trigger:
         self.last_t = -math.inf
         self.done = False  # single mode has fired
 
-    def key(self) -> tuple:
-        return (self.mode, self.position, self.increment, self.next_at, self.done)
 
     def next_time(self, axis: Axis, now: float) -> float:
         """The time of the next pulse after `now` (inf if none while the profile runs)."""
