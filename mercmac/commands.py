@@ -64,6 +64,9 @@ class Command(NamedTuple):
     models: frozenset = BOTH
     report: str | None = None  # report identifier, e.g. "P:"
     storable: bool = True  # may stand in a macro (MS176E §3.8, §6.4 RT)
+    power_on: tuple[tuple[str, int], ...] = ()  # (model, value) after power-on or RT
+    reads: str | None = None  # the setting a report command reports (§6.2)
+    unsigned: bool = False  # the report shows its value without a sign (§6.4 examples)
 
     @property
     def section(self) -> str:
@@ -99,9 +102,18 @@ def _c(mnemonic, summary, kind, page, **kw) -> Command:
     return Command(mnemonic, summary, kind, page, **kw)
 
 
+def _on(c863: int | None = None, c663: int | None = None) -> dict:
+    """power_on=: the values a setting holds after power-on, per model."""
+    return {"power_on": tuple((model, v) for model, v in ((C863, c863), (C663, c663))
+                              if v is not None)}
+
+
 _REQ, _OPT = Arg.REQUIRED, Arg.OPTIONAL
 _M, _W, _X, _E, _R = Kind.MOTION, Kind.WAIT, Kind.CONDITION, Kind.CALL, Kind.REPEAT
 _O, _S, _T, _MM = Kind.OUTPUT, Kind.SETTING, Kind.REPORT, Kind.MACRO
+# power_on: MS176E §3.4.1 (C-863: DP 35, DI 0, DD 0, DL 2000, FP 35, FL 2000, FT/FN 10000 Hz,
+# FQ 0.8 as 80, WT 0, WW 5; §6.4 SM default 2000) and §3.4.2 (C-663: DC 200 mA, HC 100 mA,
+# HT 200 ms); the other settings start at 0.
 _GAIN = dict(arg=_OPT, arg_name="a gain", lo=0, hi=MAX_UINT16, default=0, note_default=True)
 
 _TABLE = (
@@ -122,7 +134,7 @@ _TABLE = (
        arg=_REQ, arg_name="a maximum velocity", lo=1000, hi=500_000),
     _c("JF", "Joystick and trackball off", _M, 65),
     _c("JA", "Trackball mode on, n counts per signal transition", _M, 62,
-       arg=_REQ, arg_name="an increment", lo=0),
+       arg=_REQ, arg_name="an increment", lo=0, **_on(c863=0, c663=0)),
     _c("MN", "Motor (servo) on", _M, 69),
     _c("MF", "Motor (servo) off", _M, 69),
     # -- waits (§6.4) --
@@ -169,62 +181,67 @@ _TABLE = (
     _c("JL", "Lower soft limit", _S, 64, arg=_REQ, arg_name="a position",
        lo=-MAX_INT32, hi=MAX_INT32),
     _c("JB", "Joystick bias added to the joystick reading", _S, 63,
-       arg=_REQ, arg_name="a bias", lo=-255, hi=255),
+       arg=_REQ, arg_name="a bias", lo=-255, hi=255, **_on(c863=0, c663=0)),
     _c("JT", "Load a predefined joystick table (0-3)", _S, 66,
        arg=_REQ, arg_name="a table number", lo=0, hi=3),
-    _c("SI", "Joystick table index", _S, 73, arg=_REQ, arg_name="a table index", lo=0, hi=255),
+    _c("SI", "Joystick table index", _S, 73, arg=_REQ, arg_name="a table index", lo=0, hi=255,
+       **_on(c863=0, c663=0)),
     # §6.4 SJ says -1024..1024, §3.6.2 says 0..1024: accept the wider range.
     _c("SJ", "Joystick table value at the current index", _S, 73,
-       arg=_REQ, arg_name="a table value", lo=-1024, hi=1024),
+       arg=_REQ, arg_name="a table value", lo=-1024, hi=1024, **_on(c863=0, c663=0)),
     _c("SC", "Select this controller (autostart macro only)", _S, 72,
        arg=_REQ, arg_name="an address", lo=0, hi=15),
     # §6.4 DD says 0 < n < 32,767 in its heading and 0..65,535 in its text.
-    _c("DD", "Derivative gain, position control", _S, 50, models=ONLY_863, **_GAIN),
-    _c("DI", "Integral gain, position control", _S, 50, models=ONLY_863, **_GAIN),
-    _c("DL", "Integral limit, position control", _S, 51, models=ONLY_863, **_GAIN),
-    _c("DP", "Proportional gain, position control", _S, 51, models=ONLY_863, **_GAIN),
+    _c("DD", "Derivative gain, position control", _S, 50, models=ONLY_863, **_GAIN, **_on(c863=0)),
+    _c("DI", "Integral gain, position control", _S, 50, models=ONLY_863, **_GAIN, **_on(c863=0)),
+    _c("DL", "Integral limit, position control", _S, 51, models=ONLY_863, **_GAIN,
+       **_on(c863=2000)),
+    _c("DP", "Proportional gain, position control", _S, 51, models=ONLY_863, **_GAIN,
+       **_on(c863=35)),
     # §6.4 FA says 0..1024, §4.1.5 says -1000 < n < 1000: accept both.
     _c("FA", "Force control target", _S, 52, models=ONLY_863,
-       arg=_REQ, arg_name="a force target", lo=-1000, hi=1024),
-    _c("FD", "Derivative gain, force control", _S, 53, models=ONLY_863, **_GAIN),
-    _c("FI", "Integral gain, force control", _S, 54, models=ONLY_863, **_GAIN),
-    _c("FL", "Integral limit, force control", _S, 55, models=ONLY_863, **_GAIN),
-    _c("FP", "Proportional gain, force control", _S, 57, models=ONLY_863, **_GAIN),
+       arg=_REQ, arg_name="a force target", lo=-1000, hi=1024, **_on(c863=0)),
+    _c("FD", "Derivative gain, force control", _S, 53, models=ONLY_863, **_GAIN, **_on(c863=0)),
+    _c("FI", "Integral gain, force control", _S, 54, models=ONLY_863, **_GAIN, **_on(c863=0)),
+    _c("FL", "Integral limit, force control", _S, 55, models=ONLY_863, **_GAIN, **_on(c863=2000)),
+    _c("FP", "Proportional gain, force control", _S, 57, models=ONLY_863, **_GAIN, **_on(c863=35)),
     _c("FM", "Control mode (0 position, 1 force, 2 both)", _S, 55, models=ONLY_863,
-       arg=_REQ, arg_name="a control mode", lo=0, hi=2),
+       arg=_REQ, arg_name="a control mode", lo=0, hi=2, **_on(c863=0)),
     _c("FN", "Notch filter frequency in Hz", _S, 56, models=ONLY_863,
-       arg=_REQ, arg_name="a frequency", lo=40, hi=10_000),
+       arg=_REQ, arg_name="a frequency", lo=40, hi=10_000, **_on(c863=10_000)),
     _c("FO", "Offset of the additional sensor input", _S, 57, models=ONLY_863,
-       arg=_REQ, arg_name="an offset", lo=-2048, hi=2048),
+       arg=_REQ, arg_name="an offset", lo=-2048, hi=2048, **_on(c863=0)),
     _c("FQ", "Notch filter edge times 100", _S, 58, models=ONLY_863,
-       arg=_REQ, arg_name="an edge value", lo=0, hi=MAX_UINT16),
+       arg=_REQ, arg_name="an edge value", lo=0, hi=MAX_UINT16, **_on(c863=80)),
     _c("FS", "Force sign (0 positive, 1 negative)", _S, 59, models=ONLY_863,
-       arg=_REQ, arg_name="a sign", lo=0, hi=1),
+       arg=_REQ, arg_name="a sign", lo=0, hi=1, **_on(c863=0)),
     _c("FT", "Low-pass filter frequency of the additional sensor in Hz", _S, 59,
-       models=ONLY_863, arg=_REQ, arg_name="a frequency", lo=40, hi=10_000),
+       models=ONLY_863, arg=_REQ, arg_name="a frequency", lo=40, hi=10_000, **_on(c863=10_000)),
     _c("SB", "Trackball input filter", _S, 72, models=ONLY_863,
-       arg=_REQ, arg_name="a filter count", lo=0, hi=MAX_UINT16),
+       arg=_REQ, arg_name="a filter count", lo=0, hi=MAX_UINT16, **_on(c863=0)),
     _c("SF", "Encoder input filter", _S, 73, models=ONLY_863,
-       arg=_REQ, arg_name="a filter count", lo=0, hi=255),
+       arg=_REQ, arg_name="a filter count", lo=0, hi=255, **_on(c863=0)),
     # §6.4 SM: heading 0 < n < 32,767, text 0 to 2^32.
     _c("SM", "Maximum following error", _S, 74, models=ONLY_863,
-       arg=_REQ, arg_name="a following error", lo=0, hi=2**32),
+       arg=_REQ, arg_name="a following error", lo=0, hi=2**32, **_on(c863=2000)),
     _c("WT", "Settle time in ms for on-target detection", _S, 86, models=ONLY_863,
-       arg=_REQ, arg_name="a time in ms", lo=0, hi=MAX_UINT16),
+       arg=_REQ, arg_name="a time in ms", lo=0, hi=MAX_UINT16, **_on(c863=0)),
     _c("WW", "Settle window in counts", _S, 86, models=ONLY_863,
-       arg=_REQ, arg_name="a window", lo=0, hi=MAX_UINT16),
+       arg=_REQ, arg_name="a window", lo=0, hi=MAX_UINT16, **_on(c863=5)),
     _c("DC", "Drive current in mA", _S, 49, models=ONLY_663,
-       arg=_REQ, arg_name="a current in mA", lo=0, hi=MAX_UINT16),
+       arg=_REQ, arg_name="a current in mA", lo=0, hi=MAX_UINT16, **_on(c663=200)),
     _c("HC", "Hold current in mA", _S, 61, models=ONLY_663,
-       arg=_REQ, arg_name="a current in mA", lo=0, hi=MAX_UINT16),
+       arg=_REQ, arg_name="a current in mA", lo=0, hi=MAX_UINT16, **_on(c663=100)),
     _c("HT", "Hold time in ms", _S, 62, models=ONLY_663,
-       arg=_REQ, arg_name="a time in ms", lo=0, hi=MAX_UINT16),
-    # -- reports (§5.6, §6.1.3) --
+       arg=_REQ, arg_name="a time in ms", lo=0, hi=MAX_UINT16, **_on(c663=200)),
+    # -- reports (§5.6, §6.1.3); reads: §6.2 "Corresponding Report Command", G* report the
+    # D* settings; unsigned: the query's §6.4 example shows no sign ("FM:1", "JN:20000",
+    # "WW:5"), the others show one ("JH:+250000", "ZP:+30000") --
     _c("CS", "Report checksum (firmware version)", _T, 49, report="C:"),
-    _c("GD", "Report D-term, position control", _T, 60, models=ONLY_863, report="D:"),
-    _c("GI", "Report I-term, position control", _T, 60, models=ONLY_863, report="I:"),
-    _c("GL", "Report I-limit, position control", _T, 61, models=ONLY_863, report="M:"),
-    _c("GP", "Report P-term, position control", _T, 61, models=ONLY_863, report="G:"),
+    _c("GD", "Report D-term, position control", _T, 60, models=ONLY_863, report="D:", reads="DD"),
+    _c("GI", "Report I-term, position control", _T, 60, models=ONLY_863, report="I:", reads="DI"),
+    _c("GL", "Report I-limit, position control", _T, 61, models=ONLY_863, report="M:", reads="DL"),
+    _c("GP", "Report P-term, position control", _T, 61, models=ONLY_863, report="G:", reads="DP"),
     _c("TA", "Report analog input n (0 all, 1-4 inputs, 5 joystick, 6 joystick button)",
        _T, 75, arg=_OPT, arg_name="an analog channel", lo=0, hi=6, default=0, report="An:"),
     _c("TB", "Report board address", _T, 76, report="B:"),
@@ -250,27 +267,29 @@ _TABLE = (
     _c("FD?", "Report force D-term", _T, 53, models=ONLY_863, report="FD:"),
     _c("FI?", "Report force I-term", _T, 55, models=ONLY_863, report="FI:"),
     _c("FL?", "Report force I-limit", _T, 55, models=ONLY_863, report="FL:"),
-    _c("FM?", "Report control mode", _T, 56, models=ONLY_863, report="FM:"),
-    _c("FN?", "Report notch filter frequency", _T, 56, models=ONLY_863, report="FN:"),
+    _c("FM?", "Report control mode", _T, 56, models=ONLY_863, report="FM:", unsigned=True),
+    _c("FN?", "Report notch filter frequency", _T, 56,
+       models=ONLY_863, report="FN:", unsigned=True),
     _c("FO?", "Report force sensor offset", _T, 57, models=ONLY_863, report="FO:"),
     _c("FP?", "Report force P-term", _T, 58, models=ONLY_863, report="FP:"),
-    _c("FQ?", "Report notch filter edge", _T, 58, models=ONLY_863, report="FQ:"),
-    _c("FS?", "Report force sign", _T, 59, models=ONLY_863, report="FS:"),
-    _c("FT?", "Report low-pass filter frequency", _T, 60, models=ONLY_863, report="FT:"),
-    _c("JA?", "Report trackball increment (0 = off)", _T, 63, report="JA:"),
+    _c("FQ?", "Report notch filter edge", _T, 58, models=ONLY_863, report="FQ:", unsigned=True),
+    _c("FS?", "Report force sign", _T, 59, models=ONLY_863, report="FS:", unsigned=True),
+    _c("FT?", "Report low-pass filter frequency", _T, 60,
+       models=ONLY_863, report="FT:", unsigned=True),
+    _c("JA?", "Report trackball increment (0 = off)", _T, 63, report="JA:", unsigned=True),
     _c("JB?", "Report joystick bias", _T, 63, report="JB:"),
     _c("JH?", "Report upper soft limit", _T, 64, report="JH:"),
     _c("JL?", "Report lower soft limit", _T, 65, report="JL:"),
-    _c("JN?", "Report joystick velocity (0 = off)", _T, 65, report="JN:"),
+    _c("JN?", "Report joystick velocity (0 = off)", _T, 65, report="JN:", unsigned=True),
     _c("SB?", "Report trackball filter", _T, 72, models=ONLY_863, report="SB:"),
     _c("SF?", "Report encoder filter", _T, 73, models=ONLY_863, report="SF:"),
-    _c("SI?", "Report joystick table index", _T, 73, report="I0:"),
+    _c("SI?", "Report joystick table index", _T, 73, report="I0:", unsigned=True),
     _c("SJ?", "Report joystick table value", _T, 73, report="SJ:"),
     _c("SM?", "Report maximum following error", _T, 74, models=ONLY_863, report="SM:"),
-    _c("WT?", "Report settle time", _T, 86, models=ONLY_863, report="WT:"),
-    _c("WW?", "Report settle window", _T, 87, models=ONLY_863, report="WW:"),
+    _c("WT?", "Report settle time", _T, 86, models=ONLY_863, report="WT:", unsigned=True),
+    _c("WW?", "Report settle window", _T, 87, models=ONLY_863, report="WW:", unsigned=True),
     _c("ZI?", "Report trigger increment", _T, 88, report="ZI:"),
-    _c("ZM?", "Report trigger mode", _T, 89, report="ZM:"),
+    _c("ZM?", "Report trigger mode", _T, 89, report="ZM:", unsigned=True),
     _c("ZP?", "Report trigger position", _T, 90, report="ZP:"),
     # -- macro management: not storable in a macro (§3.8.5, §6.4 RT) --
     _c("MD", "Define macro n (the rest of the line is stored)", _MM, 68,
@@ -283,6 +302,22 @@ _TABLE = (
 )
 
 COMMANDS: dict[str, Command] = {c.mnemonic: c for c in _TABLE}
+
+
+class Mnemonic:
+    """The table's mnemonics as named constants, made from it: `Mnemonic.EM == "EM"`,
+    `Mnemonic.FA_Q == "FA?"`. Code that means one command names it so; a name that is
+    no command of the table is an AttributeError (tests/test_command_table.py)."""
+
+    @staticmethod
+    def name(mnemonic: str) -> str:
+        """The constant's name of a mnemonic: 'FA?' -> 'FA_Q'."""
+        return mnemonic.replace("?", "_Q")
+
+
+for _command in _TABLE:
+    setattr(Mnemonic, Mnemonic.name(_command.mnemonic), _command.mnemonic)
+del _command
 
 
 class SingleChar(NamedTuple):

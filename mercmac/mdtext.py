@@ -19,7 +19,7 @@ import functools
 import re
 from typing import Iterable, NamedTuple
 
-from mercmac.commands import Arg, Command, lookup, nearest
+from mercmac.commands import Arg, Command, Mnemonic, lookup, nearest
 
 MAX_COMMANDS = 16  # MS176E §3.8: "Each macro can contain up to 16 base commands"
 # Longer numbers are outside every range of MS176E §6.4, and int() refuses more than
@@ -275,8 +275,8 @@ def _validate(word: str, value, model: str | None, stored: bool, slot: int | Non
     findings += _use(spec, model, stored, slot)
     from mercmac.compiler.program import Op, Role
 
-    return Checked(Op(spec.mnemonic, arg, None, Role.RAW if spec.mnemonic == "EM" else Role.NONE),
-                   tuple(findings))
+    role = Role.RAW if spec.mnemonic == Mnemonic.EM else Role.NONE
+    return Checked(Op(spec.mnemonic, arg, None, role), tuple(findings))
 
 
 def _use(spec: Command, model: str | None, stored: bool, slot: int | None) -> list[Finding]:
@@ -289,9 +289,9 @@ def _use(spec: Command, model: str | None, stored: bool, slot: int | None) -> li
         findings.append(Finding("model-unsupported", "command", "", (
             ("mnemonic", spec.mnemonic), ("target", model),
             ("models", " and ".join(sorted(spec.models))))))
-    if spec.mnemonic == "SC" and slot not in (None, 0):
+    if spec.mnemonic == Mnemonic.SC and slot not in (None, 0):
         findings.append(Finding("sc-outside-autostart", "command"))
-    if stored and spec.mnemonic == "JN":
+    if stored and spec.mnemonic == Mnemonic.JN:
         findings.append(Finding("joystick-in-macro", "command"))
     return findings
 
@@ -331,7 +331,7 @@ def normal(text: str | None) -> str:
 def split_md(line: str) -> tuple[int | None, str]:
     """'MD5,MR5000,WS100' -> (5, 'MR5000,WS100'); the slot is None when it is no number."""
     head, _, body = canonical(line).partition(",")
-    return number(head[2:]) if head.startswith("MD") else None, body
+    return number(head[2:]) if head.startswith(Mnemonic.MD) else None, body
 
 
 # -- wire commands (without their CR: mercmac.upload.protocol.command frames them) --------------
@@ -339,17 +339,17 @@ def split_md(line: str) -> tuple[int | None, str]:
 def md(slot: int, line: str | Iterable) -> str:
     """MDn,...: define macro n (MS176E §3.8.1); `line` is text or ops."""
     body = line if isinstance(line, str) else format_ops(line)
-    return f"MD{slot},{body}" if body else f"MD{slot}"
+    return f"{Mnemonic.MD}{slot},{body}" if body else f"{Mnemonic.MD}{slot}"
 
 
 def tm(slot: int | None = None) -> str:
     """TMn reads macro n back; a bare TM (or TM0) lists all but macro 0 (MS176E §6.4 TM)."""
-    return "TM" if slot is None else f"TM{slot}"
+    return Mnemonic.TM if slot is None else f"{Mnemonic.TM}{slot}"
 
 
 def tz() -> str:
     """TZ reads macro 0 back (MS176E §6.4 TZ)."""
-    return "TZ"
+    return Mnemonic.TZ
 
 
 def tell(slot: int) -> str:
@@ -359,14 +359,14 @@ def tell(slot: int) -> str:
 
 def rz() -> str:
     """RZ removes macro 0 (MS176E §6.4 RZ)."""
-    return "RZ"
+    return Mnemonic.RZ
 
 
 def rm(slot: int) -> str:
     """RMn removes macro n, 1-31; never a bare RM, which removes all but 0 (MS176E §6.4 RM)."""
     if not 1 <= slot <= 31:
         raise ValueError(f"no macro slot {slot} for RM (1-31; RZ removes macro 0)")
-    return f"RM{slot}"
+    return f"{Mnemonic.RM}{slot}"
 
 
 def remove(slot: int) -> str:
@@ -376,9 +376,9 @@ def remove(slot: int) -> str:
 
 def rt() -> str:
     """RT resets as after power-on, so macro 0 runs (MS176E §6.4 RT)."""
-    return "RT"
+    return Mnemonic.RT
 
 
 def ve() -> str:
     """VE names the model and the firmware version (MS176E §6.4 VE)."""
-    return "VE"
+    return Mnemonic.VE

@@ -213,3 +213,13 @@ def test_no_rejection_the_techniques_could_express_and_the_meaning_is_kept(text)
     for m in result.program.macros.values():
         assert len(m.ops) <= MAX_COMMANDS, (text, m.md)
     assert means_the_same(text, range(0, 16, 3)), text
+
+
+def test_a_closing_brace_ends_its_statement_as_in_the_issue():
+    """`repeat 3 { ... }  CP 1` on one line: the brace separates, as a comma would."""
+    body = ", ".join(MR[:15]) + ", TT"
+    lines, found = lowered("autostart { repeat 3 { " + body + " }  CP 1 }\n")
+    assert found == [] and lines == [
+        "MD1,MR1,MR2,MR3", "MD0,EM1," + ",".join(m.replace(" ", "") for m in MR[3:15]) + ",TT,RP2,CP1"]
+    lines, found = lowered("macro x { TP }\nautostart { repeat 3 { CN1, TT, goto x }  CN2 }\n")
+    assert found == ["goto-ends-loop"] and lines == ["MD1,TP", "MD0,CN1,TT,EM1"]

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+from mercmac.commands import Mnemonic
 from mercmac.compiler import ast
 from mercmac.compiler.checks import Env
 from mercmac.compiler.program import (MAX_COMMANDS, SLOTS, Macro, Op, Origin, Program, Role,
@@ -54,7 +55,8 @@ def _calls_on(ops: list) -> bool:
     if not calls:
         return False
     ends_in_goto = _is_em(ops[-1]) and ops[-1].role is Role.GOTO
-    exits_after = any(isinstance(op, Op) and op.mnemonic in ("XN", "XF") for op in ops[calls[0]:])
+    exits_after = any(isinstance(op, Op) and op.mnemonic in (Mnemonic.XN, Mnemonic.XF)
+                      for op in ops[calls[0]:])
     return exits_after or not ends_in_goto
 
 
@@ -67,7 +69,7 @@ def _unchained(ops: list) -> list:
 
 
 def _is_em(op) -> bool:
-    return isinstance(op, _Em) or (isinstance(op, Op) and op.mnemonic == "EM")
+    return isinstance(op, _Em) or (isinstance(op, Op) and op.mnemonic == Mnemonic.EM)
 
 
 class _Lowerer:
@@ -158,7 +160,7 @@ class _Lowerer:
 
     def command(self, op: Op, owner: _Macro) -> Op:
         """A native command; a TI moved away from the RP of its loop is reported."""
-        if op.mnemonic == "TI" and self.loops and self.loops[-1] is not owner \
+        if op.mnemonic == Mnemonic.TI and self.loops and self.loops[-1] is not owner \
                 and op.span not in self.warned:
             self.warned.add(op.span)
             self.report.add("ti-moved", op.span, owner=owner.name, loop=self.loops[-1].name)
@@ -182,14 +184,15 @@ class _Lowerer:
         self.loops.pop()
         if isinstance(stmt, ast.Repeat):
             # RP n runs the line n+1 times; two RPs multiply (program.rp_counts)
-            return body + [Op("RP", n, stmt.span) for n in rp_counts(self.count(stmt))]
+            return body + [Op(Mnemonic.RP, n, stmt.span) for n in rp_counts(self.count(stmt))]
         # every T: wait T (several WAs past 65535 ms), then RP,RP = 65536 x 65536
         # passes, "forever" (§3.8.6 Example 1)
-        waits = [Op("WA", ms, stmt.span) for ms in wait_pieces(self.value(stmt.period) or 0)]
-        return body + waits + [Op("RP", None, stmt.span), Op("RP", None, stmt.span)]
+        waits = [Op(Mnemonic.WA, ms, stmt.span)
+                 for ms in wait_pieces(self.value(stmt.period) or 0)]
+        return body + waits + [Op(Mnemonic.RP, None, stmt.span), Op(Mnemonic.RP, None, stmt.span)]
 
     def conditions(self, stmt: ast.When) -> list:
-        return [Op("XF" if c.negated else "XN", self.value(c.value), c.span)
+        return [Op(Mnemonic.XF if c.negated else Mnemonic.XN, self.value(c.value), c.span)
                 for c in stmt.conditions if self.value(c.value) is not None]
 
     def count(self, stmt: ast.Repeat) -> int:
@@ -252,7 +255,7 @@ class _Lowerer:
         plain commands into macros it calls: those call nothing, so it keeps its
         return point."""
         while m.origin is not Origin.RAW and len(m.ops) > MAX_COMMANDS:
-            last = max((i for i, op in enumerate(m.ops) if _is_op(op, "RP")), default=-1)
+            last = max((i for i, op in enumerate(m.ops) if _is_op(op, Mnemonic.RP)), default=-1)
             if last + 1 < MAX_COMMANDS:
                 self.chain(m)
                 return
@@ -308,7 +311,7 @@ def _is_op(op, mnemonic: str) -> bool:
 
 # Commands that behave the same in a called macro: not calls, conditions (they
 # would end the called macro, not the loop), RP, or TI (it reads the loop's counter).
-_STAY = ("EM", "XN", "XF", "RP", "TI")
+_STAY = (Mnemonic.EM, Mnemonic.XN, Mnemonic.XF, Mnemonic.RP, Mnemonic.TI)
 
 
 def _movable_runs(ops: list) -> list[tuple[int, int]]:
@@ -328,7 +331,7 @@ def _movable_runs(ops: list) -> list[tuple[int, int]]:
 def _nothing(span: Span) -> list:
     """An empty macro: `WA0`, a command that does nothing, so that the slot holds no
     older macro (a bare `MDn` is no form of the manual's `MDn,<commands>`, §3.8.1)."""
-    return [Op("WA", 0, span)]
+    return [Op(Mnemonic.WA, 0, span)]
 
 
 def _ends_in_goto(body: tuple, count) -> bool:
@@ -341,7 +344,7 @@ def _ends_in_goto(body: tuple, count) -> bool:
 
 def _has_ti(body: tuple) -> bool:
     """Whether a TI stands in the block, at any depth."""
-    return any(s.word.upper() == "TI" if isinstance(s, ast.Command)
+    return any(s.word.upper() == Mnemonic.TI if isinstance(s, ast.Command)
                else _has_ti(getattr(s, "body", ())) for s in body)
 
 
@@ -355,7 +358,7 @@ def _span_of(op, default: Span) -> Span:
 
 def _final(op) -> Op:
     if isinstance(op, _Em):
-        return Op("EM", op.target.slot, op.span, op.role)
+        return Op(Mnemonic.EM, op.target.slot, op.span, op.role)
     return op
 
 

@@ -6,10 +6,11 @@ contradictory conditions, the 16-command limit and goto placement.
 """
 from __future__ import annotations
 
+from mercmac.commands import Mnemonic
 from mercmac.compiler.program import MAX_COMMANDS, USER_ORIGINS, Macro, Op, Origin, Program, Role
 from mercmac.diagnostics import Report, Severity
 
-_CONDITIONS = ("XN", "XF")
+_CONDITIONS = (Mnemonic.XN, Mnemonic.XF)
 
 
 def check_program(program: Program, report: Report) -> None:
@@ -19,7 +20,7 @@ def check_program(program: Program, report: Report) -> None:
         _placement(m, report)
         _contradictions(m, report)
         for i, op in enumerate(m.ops):
-            if op.mnemonic == "EM":
+            if op.mnemonic == Mnemonic.EM:
                 _call(program, m, i, op, report)
     _reachability(program, report)
 
@@ -32,7 +33,7 @@ def _length(m: Macro, report: Report) -> None:
 
 def _placement(m: Macro, report: Report) -> None:
     for i, op in enumerate(m.ops):
-        if op.mnemonic == "SC" and m.slot != 0:
+        if op.mnemonic == Mnemonic.SC and m.slot != 0:
             moved = "" if m.origin in USER_ORIGINS else "moved"
             report.add("sc-outside-autostart", op.span or m.span, moved, macro=m.label)
         if op.role == Role.GOTO and i != len(m.ops) - 1:
@@ -44,7 +45,7 @@ def _contradictions(m: Macro, report: Report) -> None:
     for op in m.ops:
         if op.mnemonic not in _CONDITIONS:
             continue
-        other = seen.get(("XF" if op.mnemonic == "XN" else "XN", op.arg))
+        other = seen.get((Mnemonic.XF if op.mnemonic == Mnemonic.XN else Mnemonic.XN, op.arg))
         if other is not None:
             report.add("contradictory-condition", op.span or m.span, macro=m.label,
                        input=op.arg, first=other.text, second=op.text)
@@ -70,7 +71,7 @@ def _call(program: Program, caller: Macro, index: int, op: Op, report: Report) -
     if _returns(program, callee, remainder):
         return
     inner = program.macros[next(o.arg for o in callee.ops
-                                if o.mnemonic == "EM" and o.arg in program.macros)]
+                                if o.mnemonic == Mnemonic.EM and o.arg in program.macros)]
     raw = op.role == Role.RAW  # on raw blocks the manual's own way of switching modes
     report.add("nested-call", op.span or caller.span, "" if raw else _advice(op, inner),
                severity=Severity.WARNING if raw else Severity.ERROR, caller=caller.label,
@@ -81,12 +82,14 @@ def _call(program: Program, caller: Macro, index: int, op: Op, report: Report) -
 def _returns(program: Program, callee: Macro, remainder: list[Op]) -> bool:
     """Whether calling `callee` still lets the caller finish its line as written."""
     # An EM to an empty slot does nothing (MS176E §6.4 EM), so it keeps the return point.
-    ems = [i for i, o in enumerate(callee.ops) if o.mnemonic == "EM" and o.arg in program.macros]
+    ems = [i for i, o in enumerate(callee.ops)
+           if o.mnemonic == Mnemonic.EM and o.arg in program.macros]
     if not ems:
         return True
     if any(o.mnemonic in _CONDITIONS for o in callee.ops[ems[0]:]):
         return False  # an XN/XF after an inner call ends the program, not the callee
-    then = remainder[0].arg if len(remainder) == 1 and remainder[0].mnemonic == "EM" else None
+    alone = len(remainder) == 1 and remainder[0].mnemonic == Mnemonic.EM
+    then = remainder[0].arg if alone else None
     return _ends_on_purpose(program, callee, then)
 
 
@@ -97,7 +100,7 @@ def _ends_on_purpose(program: Program, macro: Macro, then: int | None) -> bool:
     seen = set()
     while macro.ops and macro.slot not in seen:
         last = macro.ops[-1]
-        if last.mnemonic != "EM":
+        if last.mnemonic != Mnemonic.EM:
             return False
         if last.role == Role.GOTO or (last.role == Role.CONTINUE and last.arg == then):
             return True  # raw EMs never count: on raw blocks the rule is the manual's, as written
@@ -117,7 +120,7 @@ def _goto_chain(program: Program, callee: Macro) -> list[str] | None:
     while todo:
         macro, path = todo.pop(0)
         for o in macro.ops:
-            target = program.macros.get(o.arg) if o.mnemonic == "EM" else None
+            target = program.macros.get(o.arg) if o.mnemonic == Mnemonic.EM else None
             if target is None:
                 continue
             if o.role == Role.GOTO:
@@ -141,7 +144,7 @@ def _reachability(program: Program, report: Report) -> None:
     seen, todo = {0}, [0]
     while todo:
         for op in program.macros[todo.pop()].ops:
-            if op.mnemonic == "EM" and op.arg in program.macros and op.arg not in seen:
+            if op.mnemonic == Mnemonic.EM and op.arg in program.macros and op.arg not in seen:
                 seen.add(op.arg)
                 todo.append(op.arg)
     for m in program.macros.values():

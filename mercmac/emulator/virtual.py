@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Callable
 
 from mercmac import mdtext
-from mercmac.commands import C863, SINGLE_CHARS
+from mercmac.commands import C863, SINGLE_CHARS, Mnemonic
 from mercmac.compiler.program import Macro, Op, Origin, Program
 from mercmac.errors import UsageError
 from mercmac import outfile
@@ -57,7 +57,8 @@ ERR_MACRO_RANGE, ERR_MACRO_COMMAND, ERR_COMMAND = 0x04, 0x05, 0x06
 # overflow" (§6.4 TS) and the rest of it is dropped up to its CR.
 MAX_LINE = 256
 LINES_KEPT = 10_000  # `lines` keeps the most recent ones: an emulator may run for weeks
-_MACRO_COMMANDS = {"MD", "RM", "RMALL", "RZ", "TM", "TZ", "VE"}
+_MACRO_COMMANDS = {Mnemonic.MD, Mnemonic.RM, Mnemonic.RMALL, Mnemonic.RZ, Mnemonic.TM, Mnemonic.TZ,
+                   Mnemonic.VE}
 _STATE_KEYS = ("model", "macros")
 log = logging.getLogger(__name__)
 
@@ -318,9 +319,9 @@ class VirtualController:
         equivalent = SINGLE_CHARS[char].equivalent
         if equivalent is None:
             self.report("1" if self.machine.moving() else "0")
-        elif equivalent == "AB":
-            self.machine.execute_line([Op("AB")])
-        elif equivalent == "TS":
+        elif equivalent == Mnemonic.AB:
+            self.machine.execute_line([Op(Mnemonic.AB)])
+        elif equivalent == Mnemonic.TS:
             self.report(self.machine.read_status())  # "%" equals TS (§6.1.3): it reads the error
         elif char in ("+", "(") and self.model != C863:
             return  # TE/TF exist on the C-863 only (§6.3 footnote)
@@ -336,7 +337,7 @@ class VirtualController:
 
     def _command(self, line: str, now: float) -> None:
         """One command line; a refused one is error 06 (§6.4 TS) and changes nothing."""
-        if line.startswith("MD"):
+        if line.startswith(Mnemonic.MD):
             self._define(line)
             return
         try:
@@ -379,11 +380,12 @@ class VirtualController:
         return line[:index] + line[index + 1:]
 
     def _macro_command(self, name: str, arg: int | None, now: float) -> None:
-        if name == "VE":
-            self.report(self.faults.version or reports.report("VE", None, self.machine))
-        elif name in ("TZ", "TM"):
-            self._tell([0] if name == "TZ" else [arg] if arg else
-                       [s for s in self.machine.stored_macros() if s > 0], listing=name == "TM" and not arg)
+        if name == Mnemonic.VE:
+            self.report(self.faults.version or reports.report(Mnemonic.VE, None, self.machine))
+        elif name in (Mnemonic.TZ, Mnemonic.TM):
+            self._tell([0] if name == Mnemonic.TZ else [arg] if arg else
+                       [s for s in self.machine.stored_macros() if s > 0],
+                       listing=name == Mnemonic.TM and not arg)
         else:  # RZ, RMn, RM, RMALL (§6.4): the VM erases; the state file follows
             self.machine.execute_line([Op(name, arg)])
             self.machine.run_until(now * 1000 + 1)

@@ -5,6 +5,7 @@ import json
 import math
 from typing import IO
 
+from mercmac.commands import Mnemonic
 from mercmac.render.console import Line, write_lines
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
@@ -93,7 +94,7 @@ def _emitted(shape: tuple) -> str:
 def _folded(fold: Folded) -> Line:
     e = fold.event
     if isinstance(e, ev.MacroEntered):
-        text = f"enter {e.label}" + (f" ({e.via})" if e.via != "EM" else "")
+        text = f"enter {e.label}" + (f" ({e.via})" if e.via != Mnemonic.EM else "")
     else:
         back = f", back to {e.back_to}" if e.back_to else ""
         why = "ends" if e.why == "end" else e.why if e.why == "stopped" else f"exits on {e.why}"

@@ -11,6 +11,7 @@ import time
 from typing import Callable
 
 from mercmac import mdtext
+from mercmac.commands import Mnemonic
 from mercmac.upload import protocol
 from mercmac.upload.protocol import ProtocolError, Status, Version
 from mercmac.upload.transport import LONGEST_REPLY, PortLost, ReadTimeout, Transport, TransportError
@@ -83,7 +84,7 @@ class Controller:
         """Every stored macro: `TM` for 1-31 in either framing of SPEC §4, then `TZ`."""
         first = self._ask(mdtext.tm(), lambda r: _lists_only(r, LISTED))
         stop = time.monotonic() + self.transport.timing.budget(self.transport.baud)
-        macros = self._macros(first, "TM")
+        macros = self._macros(first, Mnemonic.TM)
         if len(protocol.lines(first)) == 1:
             # One line then ETX: either the only macro, or the first of an
             # ETX-per-line listing (SPEC §4). More lines follow without a pause.
@@ -184,26 +185,27 @@ class Controller:
             try:
                 report = self.transport.read_report(self.transport.timing.settle, stop)
             except PortLost as e:
-                raise LinkLost(str(e), sent="TM") from None
+                raise LinkLost(str(e), sent=Mnemonic.TM) from None
             except ReadTimeout as e:
                 if e.endless:
-                    raise self._silence("TM", [], e) from None
+                    raise self._silence(Mnemonic.TM, [], e) from None
                 if e.partial.strip():
                     raise BadReply(f"TM listing cut short: {protocol.quote(e.partial)}",
-                                   sent="TM", reply=e.partial) from None
+                                   sent=Mnemonic.TM, reply=e.partial) from None
                 return
             count += len(protocol.lines(report))
             if count > len(LISTED):
                 raise Flood(f"TM listed {count} lines, more than the {len(LISTED)} slots it "
-                               f"lists; the last {protocol.quote(report)}", sent="TM", reply=report)
+                               f"lists; the last {protocol.quote(report)}", sent=Mnemonic.TM,
+                               reply=report)
             if time.monotonic() > stop:
                 raise Flood(f"TM listing still going after {count} lines; the last "
-                               f"{protocol.quote(report)}", sent="TM", reply=report)
+                               f"{protocol.quote(report)}", sent=Mnemonic.TM, reply=report)
             if _lists_only(report, LISTED):
-                for slot, text in self._macros(report, "TM").items():
+                for slot, text in self._macros(report, Mnemonic.TM).items():
                     if macros.get(slot, text) != text:
                         raise BadReply(f"TM listed macro {slot} twice with different contents",
-                                       sent="TM", reply=report)
+                                       sent=Mnemonic.TM, reply=report)
                     macros[slot] = text
 
 

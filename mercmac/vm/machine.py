@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Callable, Iterable
 
-from mercmac.commands import C663, COMMANDS, MAX_POSITION
+from mercmac.commands import C663, COMMANDS, MAX_POSITION, Mnemonic
 from mercmac.compiler.program import Op, Program
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
@@ -41,9 +41,9 @@ E_WRONG_COMMAND, E_HARD_STOP, E_SERVO_OFF, E_JOYSTICK = 0x06, 0x07, 0x0A, 0x0B
 class Wait(Enum):
     """What a blocked wait command waits for (§6.4 WS, WN, WF)."""
 
-    WS = "WS"  # the move to end (on target), then n ms
-    WN = "WN"  # input n ON
-    WF = "WF"  # input n OFF
+    WS = Mnemonic.WS  # the move to end (on target), then n ms
+    WN = Mnemonic.WN  # input n ON
+    WF = Mnemonic.WF  # input n OFF
 
 
 @dataclass(slots=True)
@@ -200,7 +200,7 @@ class Machine:
 
     def take_self_select(self) -> int | None:
         """The address an SCn in macro 0 selected since the last call (§3.1.2), once."""
-        return self.params.pop("SC", None)
+        return self.params.pop(Mnemonic.SC, None)
 
     def input(self, n: int) -> bool:
         """Whether input line n (1-6) is ON."""
@@ -314,10 +314,10 @@ class Machine:
         match opcode:
             case Opcode.XN:
                 if not self.inputs.state[arg]:
-                    self._leave(f"XN{arg}")
+                    self._leave(f"{Mnemonic.XN}{arg}")
             case Opcode.XF:
                 if self.inputs.state[arg]:
-                    self._leave(f"XF{arg}")
+                    self._leave(f"{Mnemonic.XF}{arg}")
             case Opcode.EM:
                 self._call(arg)
             case Opcode.RP:
@@ -381,7 +381,7 @@ class Machine:
                 self._joystick_table(arg)
             case Opcode.SET:
                 self.params[arg[0]] = arg[1] if arg[1] is not None else COMMANDS[arg[0]].default or 0
-            case Opcode.REPORT if arg[0] == "TS":
+            case Opcode.REPORT if arg[0] == Mnemonic.TS:
                 self._report(self.read_status())
             case Opcode.REPORT:
                 self._report(reports.report(arg[0], arg[1], self))
@@ -411,7 +411,7 @@ class Machine:
         """EMn: the ONE return point becomes 'after this EM' (§3.8.4); n empty: nothing."""
         if slot in self.chunks:
             self.ret = (self.chunk, self.ip)
-            self._enter(slot, "EM")
+            self._enter(slot, Mnemonic.EM)
 
     def _leave(self, why: str) -> bool:
         """The macro ends or a condition fails: continue at the return point, or stop."""
@@ -511,8 +511,8 @@ class Machine:
         self._motion("home search", lambda t: found.append(self.axis.find_edge(t, mode)))
         if not found[0]:
             self._hazard("reference-not-found",
-                         f"FE{mode} searches away from the reference switch and runs to the end "
-                         "of travel")
+                         f"{Mnemonic.FE}{mode} searches away from the reference switch and runs "
+                         "to the end of travel")
 
     def _servo(self, on: bool) -> None:
         """MN: servo on, target := position (§6.4 MN); MF: servo off, the profile stops."""
@@ -555,7 +555,7 @@ class Machine:
         self.trigger.rearm()
 
     def _joystick_table(self, table: int) -> None:
-        self.params["JT"] = table
+        self.params[Mnemonic.JT] = table
         self.table_done = self.clock.now + JT_US
         self.wake = self.table_done
 

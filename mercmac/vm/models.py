@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from mercmac.commands import C663, C863, MAX_INT32, MODELS
+from mercmac.commands import C663, C863, COMMANDS, MAX_INT32, MODELS
 
 
 class ModelError(ValueError):
@@ -22,19 +22,18 @@ class Defaults:
     settings: tuple[tuple[str, int], ...]  # values reported by GP, FP?, WW?, ...
 
 
+def _settings(model: str) -> tuple[tuple[str, int], ...]:
+    """The power-on values of the settings, from the command table (§3.4.1, §3.4.2)."""
+    return tuple((c.mnemonic, v) for c in COMMANDS.values() for on, v in c.power_on if on == model)
+
+
 DEFAULTS = {
-    # §3.4.1: SV 45000, SA 400000, DP 35, DI 0, DD 0, DL 2000, FP 35, FL 2000,
-    # FT/FN 10000 Hz, FQ 0.8 (80), LH, LN, BN, JH/JL +-100,000,000, WT 0, WW 5;
-    # §6.4 SM default 2000.
-    C863: Defaults(45_000, 400_000, 100_000_000, -100_000_000, True, (
-        ("DP", 35), ("DI", 0), ("DD", 0), ("DL", 2000), ("FM", 0), ("FP", 35), ("FI", 0),
-        ("FD", 0), ("FL", 2000), ("FT", 10_000), ("FN", 10_000), ("FQ", 80), ("FS", 0),
-        ("FA", 0), ("FO", 0), ("WT", 0), ("WW", 5), ("SM", 2000), ("SB", 0), ("SF", 0),
-        ("JB", 0), ("JA", 0), ("SI", 0), ("SJ", 0))),
-    # §3.4.2: SV 20000, SA 250000, DC 200 mA, HC 100 mA, HT 200 ms, LL, LN, BN; the
+    # §3.4.1: SV 45000, SA 400000, LH, LN, BN, JH/JL +-100,000,000; the settings'
+    # values (DP 35, DL 2000, WW 5, SM 2000, ...) are in the command table (power_on).
+    C863: Defaults(45_000, 400_000, 100_000_000, -100_000_000, True, _settings(C863)),
+    # §3.4.2: SV 20000, SA 250000, LL, LN, BN; DC, HC, HT in the command table. The
     # manual gives no soft limits for the C-663, so they start cleared (§6.4 JC values).
-    C663: Defaults(20_000, 250_000, MAX_INT32, -MAX_INT32, False, (
-        ("DC", 200), ("HC", 100), ("HT", 200), ("JB", 0), ("JA", 0), ("SI", 0), ("SJ", 0))),
+    C663: Defaults(20_000, 250_000, MAX_INT32, -MAX_INT32, False, _settings(C663)),
 }
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from enum import Enum, IntEnum
 
-from mercmac.commands import COMMANDS, Kind
+from mercmac.commands import COMMANDS, Kind, Mnemonic
 
 
 class Opcode(IntEnum):
@@ -102,7 +102,7 @@ def opcode_for(mnemonic: str, arg: int | None) -> Opcode:
     command = COMMANDS.get(mnemonic)
     if command is None:
         return Opcode.BAD
-    if mnemonic == "AB" and arg == 1:  # §6.4 AB1: "AB1" is a command of its own
+    if mnemonic == Mnemonic.AB and arg == 1:  # §6.4 AB1: "AB1" is a command of its own
         return Opcode.AB1
     if mnemonic in Opcode.__members__:
         return Opcode[mnemonic]

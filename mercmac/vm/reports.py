@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from mercmac.commands import C663, COMMANDS
+from mercmac.commands import C663, COMMANDS, Command, Mnemonic
 
 if TYPE_CHECKING:
     from mercmac.vm.machine import Machine
@@ -17,12 +17,6 @@ CHECKSUM = "C:0230-15"
 VERSION = "(c)2009 Physik Instrumente(PI) Karlsruhe, {model}, Ver. {firmware}, 2009-21-07"
 TABLE_DONE = "Table done"  # §6.4 JT: sent when the table is generated
 
-# §6.2 "Corresponding Report Command": G* report the D* settings.
-_GETS = {"GD": "DD", "GI": "DI", "GL": "DL", "GP": "DP"}
-# Queries whose examples in §6.4 show no sign ("FM:1", "JN:20000", "WW:5"); the
-# others show one ("JH:+250000", "ZP:+30000").
-_UNSIGNED = frozenset({"FM?", "FN?", "FQ?", "FS?", "FT?", "JA?", "JN?", "WT?", "WW?", "ZM?", "SI?"})
-
 
 def number(identifier: str, value: float) -> str:
     """'P:+0000005555': sign and ten digits (§6.4 TP, TT, TI, TL, GL examples)."""
@@ -31,58 +25,60 @@ def number(identifier: str, value: float) -> str:
 
 def report(mnemonic: str, arg: int | None, m: Machine) -> str:
     """The report of one report command (kind REPORT in the command table)."""
-    ident = COMMANDS[mnemonic].report or ""
+    command = COMMANDS[mnemonic]
+    ident = command.report or ""
     if mnemonic.endswith("?"):
-        return _query(mnemonic, ident, m)
-    if mnemonic in _GETS:
-        return number(ident, m.setting(_GETS[mnemonic]))
+        return _query(command, ident, m)
+    if command.reads:  # G*: the D* setting (§6.2)
+        return number(ident, m.setting(command.reads))
     t = m.clock.now
     axis = m.axis
     match mnemonic:
-        case "TP":
+        case Mnemonic.TP:
             return number(ident, axis.position(t))
-        case "TT":
+        case Mnemonic.TT:
             return number(ident, axis.target)
-        case "TI":
+        case Mnemonic.TI:
             return number(ident, m.iteration())
-        case "TL":
+        case Mnemonic.TL:
             return number(ident, axis.sa)
-        case "TY":
+        case Mnemonic.TY:
             return number(ident, axis.sv)
-        case "TV":
+        case Mnemonic.TV:
             return number(ident, axis.velocity(t))
-        case "TD":  # the dynamic target: the profile's position (perfect tracking)
+        case Mnemonic.TD:  # the dynamic target: the profile's position (perfect tracking)
             return number(ident, axis.position(t))
-        case "TE":  # §6.4 TE: target minus actual position
+        case Mnemonic.TE:  # §6.4 TE: target minus actual position
             return number(ident, axis.target - round(axis.position(t)))
-        case "TF" | "TR":  # the model tracks perfectly and has no force sensor
+        case Mnemonic.TF | Mnemonic.TR:  # the model tracks perfectly and has no force sensor
             return number(ident, 0)
-        case "TC":
+        case Mnemonic.TC:
             return channel(arg or 0, m)
-        case "TA":
+        case Mnemonic.TA:
             return analog(arg or 0, m)
-        case "TS":
+        case Mnemonic.TS:
             return status(m)
-        case "TB":
+        case Mnemonic.TB:
             return f"B:{m.options.address}"
-        case "CS":
+        case Mnemonic.CS:
             return CHECKSUM
-        case "VE":
+        case Mnemonic.VE:
             return VERSION.format(model=m.model, firmware=m.options.firmware)
-        case "TM":
+        case Mnemonic.TM:
             return macros(m, [arg] if arg else [s for s in m.stored_macros() if s != 0])
-        case "TZ":
+        case Mnemonic.TZ:
             return macros(m, [0])
     raise ValueError(f"no report format for {mnemonic}")
 
 
-def _query(mnemonic: str, ident: str, m: Machine) -> str:
+def _query(command: Command, ident: str, m: Machine) -> str:
     """'JH:+250000', 'ZM:2': the value set by the command the query belongs to."""
-    setting = mnemonic[:-1]
-    value = {"JH": m.axis.jh, "JL": m.axis.jl, "JN": m.axis.joystick, "ZM": m.trigger.mode,
-             "ZP": m.trigger.position, "ZI": m.trigger.increment}.get(setting)
+    setting = command.mnemonic[:-1]
+    value = {Mnemonic.JH: m.axis.jh, Mnemonic.JL: m.axis.jl, Mnemonic.JN: m.axis.joystick,
+             Mnemonic.ZM: m.trigger.mode, Mnemonic.ZP: m.trigger.position,
+             Mnemonic.ZI: m.trigger.increment}.get(setting)
     value = m.setting(setting) if value is None else value
-    return f"{ident}{value}" if mnemonic in _UNSIGNED else f"{ident}{value:+d}"
+    return f"{ident}{value}" if command.unsigned else f"{ident}{value:+d}"
 
 
 def channel(n: int, m: Machine) -> str:
