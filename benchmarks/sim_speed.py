@@ -60,10 +60,15 @@ def measure(args: list[str]) -> tuple[float, dict]:
     """Run `mercmac sim ... --format json` in a fresh interpreter; wall seconds and result."""
     import json
 
+    import tempfile
+
+    # From a neutral folder with bytecode on: the installed package as a user runs it, not
+    # the repository's sources compiled afresh (PYTHONDONTWRITEBYTECODE) on every run.
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     start = time.perf_counter()
     done = subprocess.run([sys.executable, "-m", "mercmac", "sim", *args, "--format", "json"],
                           input=LOOP if args[0] == "-" else None, capture_output=True,
-                          text=True, check=True)
+                          text=True, check=True, cwd=tempfile.gettempdir(), env=env)
     return time.perf_counter() - start, json.loads(done.stdout)
 
 
