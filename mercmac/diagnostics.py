@@ -69,6 +69,12 @@ caret.""", {
         "decimal": "arguments are whole numbers (counts, steps, ms); there is no decimal point",
         "argument": "{expects}, found {found}",
         "placeholder": "{expects}, found the placeholder '{placeholder}'",
+        "keyword": "unknown word '{word}'; did you mean '{keyword}'?",
+        "or": "there is no 'or': write one when block per condition, e.g. "
+              "`when 1 {{ ... }}` and `when 2 {{ ... }}`",
+        "milliseconds": "{command} takes plain milliseconds, without a unit: write "
+                        "{command} {ms} for {written}",
+        "unit": "{command} takes a plain number, without a unit ('{written}')",
         # named errors: parse.py keeps snippets that fail the same way (lark's match_examples)
         "comma": "commands are separated by commas",
         "outside": "a command must stand in a [MCnn] block or in a macro/autostart block",
@@ -315,8 +321,18 @@ class Diagnostic(NamedTuple):
             "file": self.file,
             "line": self.span.line,
             "column": self.span.column,
+            "end_line": self.end[0],
+            "end_column": self.end[1],
             "message": self.message,
         }
+
+    @property
+    def end(self) -> tuple[int, int]:
+        """Line and column just past the span (a span without an end marks one character)."""
+        span = self.span
+        if span.end_line and (span.end_line, span.end_column) > (span.line, span.column):
+            return span.end_line, span.end_column
+        return span.line, span.column + 1
 
 
 class Report:

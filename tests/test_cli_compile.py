@@ -40,7 +40,8 @@ def test_check_json_is_spec_shaped():
     data = json.loads(r.output)
     assert r.exit_code == 1
     first = data["diagnostics"][0]
-    assert set(first) == {"rule", "code", "severity", "file", "line", "column", "message"}
+    assert set(first) == {"rule", "code", "severity", "file", "line", "column", "end_line",
+                          "end_column", "message"}
     assert [(d["rule"], d["line"]) for d in data["diagnostics"]] == [
         ("duplicate-slot", 7), ("syntax", 7), ("duplicate-slot", 8)]
 

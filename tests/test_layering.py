@@ -33,6 +33,7 @@ FORBIDDEN = {
     "mercmac.sim": {"cli", "upload", "emulator"},
     "mercmac.emulator": {"cli", "sim", "render"},
     "mercmac.render": {"cli"},
+    "mercmac.fmt": {"vm", "upload", "emulator", "sim", "cli", "render"},  # reads the compiler's tokens
 }
 
 

@@ -23,6 +23,7 @@ class _Commands(click.Group):
         "ports": ("mercmac.cli.upload", "ports"),
         "scan": ("mercmac.cli.upload", "scan"),
         "emulate": ("mercmac.cli.upload", "emulate"),
+        "lsp": ("mercmac.cli.lsp", "lsp"),
     }
 
     def list_commands(self, ctx: click.Context) -> list[str]:
@@ -44,27 +45,49 @@ def main() -> None:
     PI Mercury C-663 / C-863 controllers."""
 
 
+FORMATS = ["text", "json", "github", "sarif", "concise"]
+
+
 @main.command()
-@click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False, allow_dash=True))
+@click.argument("files", nargs=-1, required=True, type=click.Path(allow_dash=True))
 @click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
-@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
-              show_default=True, help="Output for people or for programs.")
+@click.option("--output-format", "--format", "fmt", type=click.Choice(FORMATS), default="text",
+              show_default=True, help="text or concise for people; json or sarif for programs; "
+                                      "github for annotations in GitHub Actions.")
+@click.option("--select", multiple=True, metavar="RULES",
+              help="Report only these rules: codes or names, comma-separated or repeated.")
+@click.option("--ignore", multiple=True, metavar="RULES",
+              help="Never report these rules: codes or names, comma-separated or repeated.")
+@click.option("--statistics", is_flag=True,
+              help="Count the diagnostics of each rule instead of showing them.")
+@click.option("--warnings-as-errors", is_flag=True, help="Exit 1 on warnings too.")
 @click.option("--max-diagnostics", "limit", type=click.IntRange(min=0), metavar="N",
               help="Show at most N diagnostics per file, errors first; 0 shows all. Default: "
-                   "200 in text (a closing line counts the rest), 10000 in JSON (which then "
+                   "200 in text and concise (a closing line counts the rest), 10000 in the "
+                   "others (JSON then "
                    'adds "truncated": {FILE: count left out}). The summary counts them all.')
-def check(files: tuple[str, ...], target: str | None, fmt: str, limit: int | None) -> None:
-    """Check .mcm files against the firmware's rules.
+def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[str, ...],
+          ignore: tuple[str, ...], statistics: bool, warnings_as_errors: bool,
+          limit: int | None) -> None:
+    """Check .mcm files, or every .mcm file below a folder, against the firmware's rules.
 
-    Exit 0 when no errors are found, 1 when there are errors, 2 when a file
-    cannot be read.
+    Settings (target, select, ignore) come from `[tool.mercmac]` in pyproject.toml or
+    from mercmac.toml, found upward from each file; options override them.
+    `// mercmac: ignore[RULE, ...]` on a line turns those rules off there.
+
+    Exit 0 when no errors are found, 1 when there are errors (or warnings, with
+    --warnings-as-errors), 2 when a file cannot be read or an option or setting is wrong.
     """
     def work() -> int:
-        from mercmac.render import report as render
+        from mercmac.diagnostics import Severity
         from mercmac.source import read_source
+        from mercmac import suppress
 
-        results, unreadable = [], 0
-        for f in files:
+        chosen = suppress.rule_set(select, "--select") if select else None
+        dropped = suppress.rule_set(ignore, "--ignore") if ignore else None
+        paths, unreadable = _expand(files)
+        results, found = [], []
+        for f in paths:
             try:
                 source = read_source(f)
             except OSError as e:
@@ -73,20 +96,72 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, limit: int | Non
                 say(f"cannot read {f}: {reason(e)}")
                 unreadable += 1
                 continue
-            results.append(_check_one(source, target))
+            rules, model = _rules_for(f, chosen, dropped, target)
+            results.append(_check_one(source, model))
+            found += suppress.kept(results[-1].report.items, rules, source)
         if not results:
             return EXIT_USAGE
-        found = [d for r in results for d in r.report.items]
-        if fmt == "json":
-            click.echo(render.to_json(found, render.MAX_JSON if limit is None else limit))
-        else:
-            render.write_text(found, {r.source.name: r.source for r in results}, len(results),
-                              limit=render.MAX_TEXT if limit is None else limit)
+        _show(found, results, fmt, statistics, limit)
         if unreadable:
             return EXIT_USAGE
-        return EXIT_FAILED if any(r.report.has_errors for r in results) else EXIT_OK
+        failing = {Severity.ERROR, Severity.WARNING} if warnings_as_errors else {Severity.ERROR}
+        return EXIT_FAILED if any(d.severity in failing for d in found) else EXIT_OK
 
     run_guarded(work)
+
+
+def _expand(arguments: tuple[str, ...]) -> tuple[list[str], int]:
+    """Files to check: each file as given, every .mcm below each folder (sorted); and how
+    many folders held none."""
+    import os
+
+    paths, empty = [], 0
+    for a in arguments:
+        if a == "-" or not os.path.isdir(a):
+            paths.append(a)
+            continue
+        below = sorted(os.path.join(top, name) for top, _, names in os.walk(a)
+                       for name in names if name.endswith(".mcm"))
+        if not below:
+            say(f"no .mcm files in {a}")
+            empty += 1
+        paths += below
+    return paths, empty
+
+
+def _rules_for(path: str, select, ignore, target: str | None):
+    """The rules to report on a file and its model: options, else its settings."""
+    from mercmac import config, suppress
+
+    settings = config.settings_for(path)
+    where = f"in {settings.path}"
+    if select is None and settings.select is not None:
+        select = suppress.rule_set(settings.select, f"select {where}")
+    if ignore is None:
+        ignore = suppress.rule_set(settings.ignore or (), f"ignore {where}")
+    return suppress.chosen(select, ignore), target or settings.target
+
+
+def _show(found, results, fmt: str, statistics: bool, limit: int | None) -> None:
+    """Write the diagnostics (or their counts) in the chosen format."""
+    from mercmac.render import report as render
+
+    cap = (render.MAX_TEXT if fmt in ("text", "concise") else render.MAX_JSON) if limit is None else limit
+    if statistics and fmt == "json":
+        click.echo(render.statistics_json(found))
+    elif statistics:
+        render.write_statistics(found, len(results))
+    elif fmt == "json":
+        click.echo(render.to_json(found, cap))
+    elif fmt == "sarif":
+        click.echo(render.to_sarif(found, cap))
+    elif fmt == "github":
+        click.echo(render.to_github(found, cap), nl=False)
+    elif fmt == "concise":
+        render.write_concise(found, len(results), limit=cap)
+    else:
+        render.write_text(found, {r.source.name: r.source for r in results}, len(results),
+                          limit=cap)
 
 
 def _check_one(source, target: str | None):
@@ -152,5 +227,28 @@ def explain(key: str | None) -> None:
         else:
             write_explanation(key)
         return EXIT_OK
+
+    run_guarded(work)
+
+
+@main.command("fmt")
+@click.argument("files", nargs=-1, required=True, type=click.Path(allow_dash=True))
+@click.option("--check", is_flag=True, help="Change nothing; exit 1 when a file would change.")
+@click.option("--diff", is_flag=True, help="Change nothing; print what would change as a unified "
+                                           "diff and exit 1 when a file would change.")
+def fmt_command(files: tuple[str, ...], check: bool, diff: bool) -> None:
+    """Write .mcm files (or every .mcm below a folder) in the one canonical layout;
+    the build never changes.
+
+    `-` formats standard input to standard output. Exit 0 when done (or, with
+    --check/--diff, when nothing would change), 1 when a file would change,
+    2 when a file cannot be read, written or parsed (it is left as it was).
+    """
+    def work() -> int:
+        from mercmac.cli.fmt import format_files
+
+        paths, empty = _expand(files)
+        code = format_files(tuple(paths), check=check, diff=diff) if paths else EXIT_USAGE
+        return EXIT_USAGE if empty else code
 
     run_guarded(work)

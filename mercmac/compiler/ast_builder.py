@@ -4,6 +4,7 @@ from __future__ import annotations
 from mercmac import mdtext
 from mercmac.compiler import ast
 from mercmac.compiler.parser_tables import Token, Transformer, v_args
+from mercmac.compiler.parse import BROKEN
 from mercmac.source import Span
 
 
@@ -31,11 +32,13 @@ class _Build(Transformer):
             setattr(self, name, getattr(self, name))
 
     def start(self, meta, items):
-        return ast.Module(tuple(items))
+        return ast.Module(tuple(i for i in items if i is not None))
 
     def raw_block(self, meta, children):
         tok = children[0]
         raw = tok.value  # parse.RawLine: the commands as mercmac.mdtext read them
+        if raw.problems:  # a broken line (parse_partial): left out, its error reported
+            return None
         header = Span(tok.line, tok.column, tok.line, tok.column + raw.header)
         at = tok.column + raw.header
         commands = tuple(_raw_command(c, tok.line, at) for c in raw.commands)
@@ -73,7 +76,9 @@ class _Build(Transformer):
 
     def when(self, meta, children):
         *conditions, body = children
-        return ast.When(tuple(conditions), body, _span(meta))
+        # the block a broken line opened (parse.BROKEN): no conditions, its body still checked
+        kept = tuple(c for c in conditions if not _broken(c.value))
+        return ast.When(kept, body, _span(meta))
 
     def condition(self, meta, children):
         return ast.Condition(_value(children[-1]), len(children) == 2, _span(meta))
@@ -99,6 +104,10 @@ class _Build(Transformer):
         word = children[0]
         value = _value(children[1]) if len(children) > 1 else None
         return ast.Command(word.value, value, _span(meta), _tspan(word))
+
+
+def _broken(value) -> bool:
+    return isinstance(value, ast.Name) and value.name == BROKEN
 
 
 def _raw_command(c: mdtext.Written, line: int, at: int) -> ast.Command:

@@ -8,6 +8,7 @@ from __future__ import annotations
 from mercmac import mdtext
 from mercmac.commands import MODELS, Arg, lookup
 from mercmac.compiler import ast
+from mercmac.compiler.parse import BROKEN, nearest_keyword
 from mercmac.compiler.program import MAX_WA, MAX_WAITS, SLOTS, Op, rp_counts
 from mercmac.diagnostics import Report
 from mercmac.source import Span
@@ -20,17 +21,23 @@ INPUTS = range(1, 7)  # XN/XF: 1-4 inputs, 5 joystick, 6 joystick button (§6.4 
 class Env:
     """What the checks resolved, for lowering."""
 
-    def __init__(self, target: str | None = None):
+    def __init__(self, target: str | None = None, unsure: frozenset[str] = frozenset()):
         self.target = target
+        # names a broken line may define (issue 10): not reported as undefined
+        self.unsure = unsure
         self.consts: dict[str, int] = {}
         self.macros: dict[str, ast.MacroDef] = {}
         self.ops: dict[ast.Command, Op] = {}
         self.values: dict[ast.Value, int] = {}
 
 
-def check_module(module: ast.Module, report: Report, target: str | None) -> Env:
-    """Report every AST-level problem; return the resolved environment."""
-    env = Env(target=target)
+def check_module(module: ast.Module, report: Report, target: str | None,
+                 unsure: frozenset[str] = frozenset()) -> Env:
+    """Report every AST-level problem; return the resolved environment.
+
+    `unsure`: names that lines left out of `module` (syntax errors) may define; their
+    uses are not reported as undefined, as the broken line may well define them."""
+    env = Env(target=target, unsure=unsure)
     _declarations(module, report, env)
     slots: dict[int, Span] = {}
     for item in module.items:
@@ -67,7 +74,7 @@ def _declarations(module: ast.Module, report: Report, env: Env) -> None:
             # an invalid value is reported here once; its uses resolve to None and stay quiet
             env.consts[item.name] = _resolve(item.value, env, report) if isinstance(
                 item.value, ast.Invalid) else item.value
-        elif isinstance(item, ast.MacroDef):
+        elif isinstance(item, ast.MacroDef) and item.name != BROKEN:
             first = env.macros.get(item.name)
             if first is not None:
                 report.add("duplicate-name", item.span, kind="macro", name=item.name,
@@ -138,15 +145,40 @@ def _first_goto(body: tuple):
 
 
 def _macro_name(name: str, span: Span, env: Env, report: Report) -> None:
-    if name not in env.macros:
+    if name not in env.macros and name not in env.unsure:
         hint = _suggest(name, env.macros)
         report.add("undefined-name", span, "macro", name=name, hint=hint)
 
 
 def _suggest(name: str, known) -> str:
-    close = [k for k in known if k.lower() == name.lower()] or [
-        k for k in known if k.lower().startswith(name.lower()[:3])]
+    """'did you mean' the defined name nearest to `name`: the same but for case, else the
+    fewest edits (at most a third of the name; a swap of two letters counts 1),
+    else the same first three letters."""
+    low = name.lower()
+    close = sorted(k for k in known if k.lower() == low)
+    if not close:
+        limit = len(name) // 3
+        costs = sorted((_edits(low, k.lower()), k) for k in known)
+        close = [k for cost, k in costs[:1] if cost <= limit]
+    if not close:
+        close = sorted(k for k in known if k.lower().startswith(low[:3]))
     return f"; did you mean '{close[0]}'?" if close else ""
+
+
+def _edits(a: str, b: str) -> int:
+    """Edit distance with adjacent swaps (optimal string alignment): `scna` -> `scan` is 1."""
+    if abs(len(a) - len(b)) > 3:
+        return abs(len(a) - len(b))
+    prev2: list[int] = []
+    prev = list(range(len(b) + 1))
+    for i in range(1, len(a) + 1):
+        row = [i] + [0] * len(b)
+        for j in range(1, len(b) + 1):
+            row[j] = min(prev[j] + 1, row[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1]))
+            if i > 1 and j > 1 and a[i - 1] == b[j - 2] and a[i - 2] == b[j - 1]:
+                row[j] = min(row[j], prev2[j - 2] + 1)
+        prev2, prev = prev, row
+    return prev[-1]
 
 
 def _bounded(value: ast.Value, env: Env, report: Report, allowed: range, what: str,
@@ -165,6 +197,8 @@ def _resolve(value: ast.Value, env: Env, report: Report) -> int | None:
         env.values[value] = value.value
         return value.value
     if value.name not in env.consts:
+        if value.name in env.unsure:
+            return None
         if value.name in env.macros:
             report.add("undefined-name", value.span, "const-is-macro", name=value.name)
         else:
@@ -190,7 +224,12 @@ def _command(cmd: ast.Command, env: Env, report: Report, *, raw: bool) -> None:
         value = value.value if isinstance(value, ast.Number) else mdtext.TooLong(0)
     checked = mdtext.validate(cmd.word, value, model=env.target)
     for f in checked.findings:
-        report.add(f.rule, _where(cmd, f), f.variant, **dict(f.values))
+        values = dict(f.values)
+        if f.rule == "unknown-command" and not raw and cmd.value is not None:  # `cal scan`: a keyword, not a command
+            keyword = nearest_keyword(cmd.word)
+            if keyword is not None and "hint" in values:
+                values["hint"] = f"; did you mean '{keyword}'?"
+        report.add(f.rule, _where(cmd, f), f.variant, **values)
     if checked.op is not None:
         env.ops[cmd] = checked.op._replace(span=cmd.span)
 

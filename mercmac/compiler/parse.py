@@ -15,7 +15,7 @@ import re
 from typing import NamedTuple
 
 from mercmac import mdtext
-from mercmac.commands import lookup
+from mercmac.commands import Mnemonic, lookup
 from mercmac.compiler import parser_tables as lark
 from mercmac.diagnostics import Report
 from mercmac.source import Span
@@ -99,27 +99,73 @@ def _raw_line(token):
     return token
 
 
+class Parsed(NamedTuple):
+    """What parsing a file gives: the tree of what parsed, and the lines that did not."""
+
+    tree: object | None  # None: nothing usable (a binary file, or recovery gave up mid-file)
+    broken: frozenset[int]  # lines with a syntax error: left out of `tree`
+    failed: bool = False  # any syntax error (a missing '}' at the end breaks no line)
+
+
 def parse(text: str, report: Report):
     """The parse tree of `text`, or None after reporting every syntax error."""
+    parsed = parse_partial(text, report)
+    return None if parsed.failed else parsed.tree
+
+
+def parse_partial(text: str, report: Report) -> Parsed:
+    """Report every syntax error and return the tree of the rest (issue 10).
+
+    A broken line is left out of the tree: what it held up to the error is
+    dropped with it by the builder's caller (diagnostics on broken lines are the
+    parser's), a `{` it opened is replaced by a block of no kind (an `ast.When`
+    without conditions, or a macro named BROKEN) so that its body is still read,
+    and a raw block whose commands do not read is left out. A file that ends
+    inside a block is closed as if its braces were there.
+    """
     nul = text.find("\x00")
     if nul >= 0:
         report.add("syntax", _span_at(text, nul), "binary")
-        return None
-    recovery = _Recovery(report)
+        return Parsed(None, frozenset({_span_at(text, nul).line}), True)
+    recovery = _Recovery(report, text)
     _ACTIVE.append(recovery)
     try:
         with paused_gc():
             tree = parser().parse(text + "\n", on_error=recovery)
-    except lark.UnexpectedInput:  # reported; recovery stopped at the end of the file
-        return None
+    except lark.UnexpectedInput as e:  # reported; recovery stopped
+        tree = _finish(e) if recovery.at_end else None
     finally:
         _ACTIVE.pop()
         recovery.flush()
-    if recovery.failed:
-        return None
-    if text.count("{") > MAX_NESTING:
+    broken = frozenset(recovery.lines)
+    if tree is not None and text.count("{") > MAX_NESTING:
         _limit_nesting(tree, report)
-    return tree
+    return Parsed(tree, broken, recovery.failed)
+
+
+# The name of a block that a broken line opened (see _resume): no name can be written so.
+BROKEN = " broken"
+
+
+def _finish(e):
+    """The tree of a file that ended inside blocks, its blocks closed; None if it cannot be."""
+    ip = getattr(e, "interactive_parser", None)
+    token = getattr(e, "token", None)
+    if ip is None or token is None:
+        return None
+    state = ip.parser_state
+    try:
+        for _ in range(2 * len(state.state_stack) + 4):
+            if _ends(state):
+                return ip.feed_eof(token)
+            kind = "RBRACE" if _accepts(state, "RBRACE") else "_NL"
+            if not _accepts(state, kind):
+                return None
+            state.feed_token(lark.Token.new_borrow_pos(kind, "}" if kind == "RBRACE" else "\n",
+                                                       token))
+    except lark.UnexpectedInput:
+        return None
+    return None
 
 
 def _span_at(text: str, index: int) -> Span:
@@ -131,9 +177,12 @@ def _span_at(text: str, index: int) -> Span:
 class _Recovery:
     """lark's `on_error`: report the error, skip the rest of its line and carry on."""
 
-    def __init__(self, report: Report):
+    def __init__(self, report: Report, text: str = ""):
         self.report = report
+        self.text = text
         self.failed = False
+        self.at_end = False  # stopped at the end of the file (not mid-file)
+        self.lines: set[int] = set()  # the broken lines
         self.last: tuple[int, int] | None = None  # (line, position) of the last error
         self.first = len(report.items)
         self.raw: dict[int, tuple] = {}  # line -> a raw block's syntax error, reported at the end
@@ -141,6 +190,7 @@ class _Recovery:
     def raw_error(self, token, problem) -> None:
         """A syntax error in a raw block's commands: kept unless the parser fails on its line."""
         self.failed = True
+        self.lines.add(token.line)
         column = token.column + token.value.header
         span = Span(token.line, column + problem.start, token.line, column + problem.end)
         self.raw[token.line] = (span, problem.variant, dict(problem.values))
@@ -162,11 +212,18 @@ class _Recovery:
         if (line, position) == self.last:  # no progress: give up rather than loop
             return False
         self.raw.pop(line, None)  # one error per line: the parser's
+        if not _at_end(e):  # a missing '}' at the end: the last line may well be whole
+            self.lines.add(line)
         if self.last is None or self.last[0] != line or _at_end(e):  # one error per line
-            variant, values = _message(e, line, _before(e, text))
-            self.report.add("syntax", _error_span(e, line), variant, **values)
+            hint = _hint(e, text, line)
+            if hint is not None:
+                self.report.add("syntax", hint[0], hint[1], **hint[2])
+            else:
+                variant, values = _message(e, line, _before(e, text))
+                self.report.add("syntax", _error_span(e, line), variant, **values)
         self.last = (line, position)
         if _at_end(e):
+            self.at_end = True
             return False
         try:
             return _resume(e, lexer, text, position)
@@ -195,8 +252,9 @@ def _resume(e, lexer, text: str, position: int) -> bool:
     opens, closes = code.count("{"), code.count("}")
     if opens > closes:  # a block was opened: open one in its place so that its '}' still fits
         state.feed_token(lark.Token.new_borrow_pos("_NL", "\n", where))
-        top = _accepts(state, "MACRO")  # `macro _ {` at the top, `when 1 {` in a block
-        head = (("MACRO", "macro"), ("NAME", "_")) if top else (("WHEN", "when"), ("INT", "1"))
+        top = _accepts(state, "MACRO")  # `macro _ {` at the top, `when _ {` in a block
+        head = (("MACRO", "macro"), ("NAME", BROKEN)) if top else (
+            ("WHEN", "when"), ("NAME", BROKEN))
         for kind, value in (*head, ("LBRACE", "{")):
             state.feed_token(lark.Token.new_borrow_pos(kind, value, where))
     for _ in range(closes - opens):
@@ -205,6 +263,21 @@ def _resume(e, lexer, text: str, position: int) -> bool:
         state.feed_token(lark.Token.new_borrow_pos("RBRACE", "}", where))
     if at_newline:  # the lexer has consumed it
         state.feed_token(token)
+    return True
+
+
+def _ends(state) -> bool:
+    """Whether the file may end here (the reductions `$END` implies lead to the end state)."""
+    states, end = state.parse_conf.states, state.parse_conf.end_state
+    stack = list(state.state_stack)
+    while stack[-1] != end:
+        action = states[stack[-1]].get("$END")
+        if action is None or action[0] is lark.Shift:
+            return False
+        rule = action[1]
+        if rule.expansion:
+            del stack[-len(rule.expansion):]
+        stack.append(states[stack[-1]][rule.origin.name][1])
     return True
 
 
@@ -242,6 +315,81 @@ def _limit_nesting(tree, report: Report) -> None:
                 child.children[-1].children = []
             else:
                 stack.append((child, level))
+
+
+KEYWORDS = ("target", "const", "macro", "autostart", "call", "goto", "when", "repeat", "every",
+            "not", "and")
+_STATEMENT_WORD = re.compile(r"(?:^|[,{}])[ \t]*([A-Za-z_][A-Za-z0-9_]*)")
+_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_NUMBER_BEFORE = re.compile(r"(?<![A-Za-z])([A-Za-z]{2})[ \t]*([+-]?[ \t]*\d+)[ \t]*$")
+_UNIT = re.compile(r"(ms|s|min|h|d|mm|um|nm|cm|m|deg|counts?|cts|steps?)(?![A-Za-z0-9_])",
+                   re.IGNORECASE)
+_IN_MS = (Mnemonic.WA, Mnemonic.WS)  # commands whose argument is milliseconds (MS176E §6.4)
+
+
+def nearest_keyword(word: str) -> str | None:
+    """The keyword a misspelled word most likely means (`whne` -> `when`), or None."""
+    from mercmac.commands import _distance
+
+    low = word.lower()
+    if low in KEYWORDS:  # `When 1`: keywords are lower case
+        return low if word != low else None
+    if len(low) < 3:
+        return None
+    limit = 1 if len(low) < 4 else 2
+    best = min(KEYWORDS, key=lambda k: (_distance(low, k), k))
+    if _distance(low, best) <= limit or (len(low) > 3 and sorted(low) == sorted(best)):
+        return best
+    return None
+
+
+def _hint(e, text: str, line: int):
+    """(span, variant, values) of a syntax error that has a likely cause: a misspelled
+    keyword, `or` between conditions, a unit after a number; else None."""
+    token = getattr(e, "token", None)
+    position = token.start_pos if token is not None else getattr(e, "pos_in_stream", None)
+    if not isinstance(position, int) or position < 0 or position > len(text):
+        return None
+    start = text.rfind("\n", 0, position) + 1
+    end = text.find("\n", position)
+    end = len(text) if end < 0 else end
+    if token is not None and token.type == "_NL":
+        position = min(position, end)
+    code = text[start:end].split("//", 1)[0]
+    here = position - start
+    row = text.count("\n", 0, start) + 1
+    if row != line:
+        return None
+    for m in _STATEMENT_WORD.finditer(code):  # `whne 1 {`, `macor scan {`
+        word = m.group(1)
+        if m.start(1) > here or lookup(word) is not None:
+            continue
+        keyword = nearest_keyword(word)
+        if keyword is not None:
+            span = Span(row, m.start(1) + 1, row, m.end(1) + 1)
+            return span, "keyword", {"word": word, "keyword": keyword}
+    word = _WORD.match(code, here) if here < len(code) else None
+    before = code[:here]
+    if word is not None and word.group().lower() == "or" and re.search(r"\bwhen\b", before):
+        span = Span(row, here + 1, row, word.end() + 1)
+        return span, "or", {}
+    number = _NUMBER_BEFORE.search(before)
+    unit = _UNIT.match(code, here) if number is not None else None
+    if unit is not None and lookup(number.group(1)) is not None:
+        mnemonic = lookup(number.group(1)).mnemonic
+        span = Span(row, number.start(2) + 1, row, unit.end() + 1)
+        written = number.group(2).replace(" ", "").replace("\t", "") + unit.group()
+        if mnemonic in _IN_MS and unit.group().lower() in ("ms", "s", "min", "h", "d"):
+            from mercmac.timespec import parse_duration
+
+            try:
+                ms = parse_duration(written)
+            except (ValueError, OverflowError):
+                ms = None
+            if ms is not None:
+                return span, "milliseconds", {"command": mnemonic, "written": written, "ms": ms}
+        return span, "unit", {"command": mnemonic, "written": written}
+    return None
 
 
 def _at_end(e) -> bool:

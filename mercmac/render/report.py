@@ -1,10 +1,12 @@
-"""Diagnostics as text for people (plain or rich) and as JSON (SPEC §5)."""
+"""Diagnostics as text for people (plain or rich, full or concise), as JSON (SPEC §5), as
+GitHub workflow commands and as SARIF 2.1.0."""
 from __future__ import annotations
 
+import sys
 from typing import IO, Iterable
 
 from mercmac.diagnostics import Diagnostic, Severity
-from mercmac.render.console import Line, write_lines
+from mercmac.render.console import Line, Piece, use_colour, write_lines
 from mercmac.source import Source
 
 _STYLE = {Severity.ERROR: "bold red", Severity.WARNING: "bold yellow", Severity.INFO: "bold cyan"}
@@ -29,8 +31,9 @@ def printable(text: str) -> str:
     return text.translate(_HIDDEN)
 
 
-def diagnostic_lines(d: Diagnostic, source: Source | None) -> list[Line]:
-    """`file:line:col: severity[CODE rule]: message`, the source line and a caret."""
+def diagnostic_lines(d: Diagnostic, source: Source | None, *, colour: bool = False) -> list[Line]:
+    """`file:line:col: severity[CODE rule]: message`, the source line (highlighted in
+    `colour`) and a caret."""
     lines: list[Line] = [[
         (f"{printable(d.file)}:{d.span.line}:{d.span.column}: ", "bold"),
         (str(d.severity), _STYLE[d.severity]),
@@ -44,7 +47,8 @@ def diagnostic_lines(d: Diagnostic, source: Source | None) -> list[Line]:
             width = d.span.end_column - d.span.column
         shown, caret, width = _excerpt(text, d.span.column - 1, width)
         gutter = f"{d.span.line:>5} | "
-        lines.append([(gutter, "dim"), (shown, "")])
+        code = _highlighted(text, d.span.column - 1) if colour else [(shown, "")]
+        lines.append([(gutter, "dim"), *code])
         pad = " " * (len(gutter) + caret)
         lines.append([(pad, ""), ("^" + "~" * (width - 1), _STYLE[d.severity])])
     return lines
@@ -52,16 +56,44 @@ def diagnostic_lines(d: Diagnostic, source: Source | None) -> list[Line]:
 
 def _excerpt(text: str, start: int, width: int) -> tuple[str, int, int]:
     """The part of a source line to show, escaped; the caret's offset and width in it."""
-    first = 0
-    if len(text) > WINDOW:  # a long line: a window around the caret, so output stays small
-        first = min(max(start - WINDOW // 3, 0), len(text) - WINDOW)
-    last = min(first + WINDOW, len(text))
+    first, last = _window(text, start)
     start = min(start, last)
     end = min(start + width, last)
     before = ("..." if first else "") + printable(text[first:start])
     marked = printable(text[start:end])
     after = printable(text[end:last]) + ("..." if last < len(text) else "")
     return before + marked + after, len(before), max(len(marked), 1)
+
+
+def _window(text: str, start: int) -> tuple[int, int]:
+    """The part of a source line shown, first..last: a long line shows a window around the
+    caret, so output stays small."""
+    first = 0
+    if len(text) > WINDOW:
+        first = min(max(start - WINDOW // 3, 0), len(text) - WINDOW)
+    return first, min(first + WINDOW, len(text))
+
+
+# Rich styles of the .mcm lexer's tokens (mercmac.highlight), the first prefix that fits.
+_TOKEN_STYLES = (("Token.Error", "bold red underline"), ("Token.Comment", "dim italic"),
+                 ("Token.Keyword.Constant", "cyan"), ("Token.Keyword", "magenta"),
+                 ("Token.Operator.Word", "magenta"), ("Token.Name.Builtin", "bold cyan"),
+                 ("Token.Name.Label", "bold blue"), ("Token.Name.Function", "green"),
+                 ("Token.Name.Constant", "yellow"), ("Token.Literal.Number", "bright_green"))
+
+
+def _highlighted(text: str, start: int) -> list[Piece]:
+    """_excerpt's text in the lexer's colours; only on a colour terminal, for it imports pygments."""
+    from mercmac.highlight import McmLexer
+
+    first, last = _window(text, start)
+    pieces: list[Piece] = [("...", "")] if first else []
+    for at, kind, value in McmLexer().get_tokens_unprocessed(text):
+        lo, hi = max(at, first), min(at + len(value), last)
+        if lo < hi:
+            style = next((s for p, s in _TOKEN_STYLES if str(kind).startswith(p)), "")
+            pieces.append((printable(text[lo:hi]), style))
+    return pieces + ([("...", "")] if last < len(text) else [])
 
 
 def summary_line(diagnostics: list[Diagnostic], files: int) -> Line:
@@ -81,9 +113,10 @@ def write_text(diagnostics: list[Diagnostic], sources: dict[str, Source], files:
     """Errors first, then warnings, then infos, at most `limit` per file (0: all); the
     number left out; a closing count line."""
     shown, left_out = capped(diagnostics, limit)
+    colour = use_colour(stream or sys.stdout)
     lines: list[Line] = []
     for d in shown:
-        lines += diagnostic_lines(d, sources.get(d.file))
+        lines += diagnostic_lines(d, sources.get(d.file), colour=colour)
     for file, count in left_out.items():
         lines.append([(f"{printable(file)}: {count:,} more diagnostic{'s' if count != 1 else ''} "
                        f"not shown (the first {limit} are); "
@@ -114,8 +147,6 @@ def write_errors(result, stream: IO[str] | None = None) -> bool:
     """
     if not result.report.has_errors and result.program is not None:
         return False
-    import sys
-
     write_text(result.report.items, {result.source.name: result.source}, 1, stream or sys.stderr)
     return True
 
@@ -130,3 +161,124 @@ def to_json(diagnostics: Iterable[Diagnostic], limit: int = MAX_JSON) -> str:
     if left_out:
         out["truncated"] = left_out
     return json.dumps(out, indent=2)
+
+
+# -- check's other output formats (`check --output-format`) ------------------------------
+
+def write_concise(diagnostics: list[Diagnostic], files: int, stream: IO[str] | None = None,
+                  *, limit: int = MAX_TEXT) -> None:
+    """One line per diagnostic, `file:line:col: CODE [rule] message` (ruff's concise), the
+    number left out and the closing count line."""
+    shown, left_out = capped(diagnostics, limit)
+    lines: list[Line] = [[
+        (f"{printable(d.file)}:{d.span.line}:{d.span.column}: ", "bold"),
+        (d.rule.code, _STYLE[d.severity]), (f" [{d.rule.name}]", "dim"),
+        (f" {printable(d.message)}", ""),
+    ] for d in shown]
+    lines += [[(f"{printable(file)}: {count:,} more not shown", "bold")]
+              for file, count in left_out.items()]
+    write_lines([*lines, summary_line(diagnostics, files)], stream)
+
+
+# GitHub workflow commands: the level of each severity, and the escapes of the command's
+# message and of its properties (actions/toolkit, packages/core/src/command.ts).
+_GITHUB_LEVEL = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "notice"}
+_GITHUB_DATA = str.maketrans({"%": "%25", "\r": "%0D", "\n": "%0A"})
+_GITHUB_PROPERTY = str.maketrans({"%": "%25", "\r": "%0D", "\n": "%0A", ":": "%3A", ",": "%2C"})
+
+
+def to_github(diagnostics: Iterable[Diagnostic], limit: int = MAX_JSON) -> str:
+    """`::error file=F,line=L,col=C,endLine=..,endColumn=..,title=CODE rule::message` per
+    diagnostic: GitHub Actions shows them as annotations on the pull request's lines."""
+    kept, left_out = capped(diagnostics, limit)
+    out = []
+    for d in kept:
+        end_line, end_column = d.end
+        where = {"file": d.file.replace("\\", "/"), "line": d.span.line, "col": d.span.column,
+                 "endLine": end_line, "endColumn": end_column,
+                 "title": f"{d.rule.code} {d.rule.name}"}
+        props = ",".join(f"{k}={str(v).translate(_GITHUB_PROPERTY)}" for k, v in where.items())
+        out.append(f"::{_GITHUB_LEVEL[d.severity]} {props}::{d.message.translate(_GITHUB_DATA)}")
+    for file, count in left_out.items():
+        out.append(f"::warning file={file.translate(_GITHUB_PROPERTY)}::{count} more "
+                   f"diagnostics not shown (--max-diagnostics)")
+    return "".join(line + "\n" for line in out)
+
+
+_SARIF_LEVEL = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
+SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
+
+
+def to_sarif(diagnostics: Iterable[Diagnostic], limit: int = MAX_JSON) -> str:
+    """A SARIF 2.1.0 log of one run (GitHub code scanning, editors); every rule is listed
+    in the driver, and each result points at its rule by id and index."""
+    import json
+
+    from mercmac import __version__
+    from mercmac.diagnostics import RULES
+
+    kept, left_out = capped(diagnostics, limit)
+    index = {r.code: i for i, r in enumerate(RULES)}
+    run: dict = {
+        "tool": {"driver": {"name": "mercmac", "version": __version__,
+                            "rules": [_sarif_rule(r) for r in RULES]}},
+        "columnKind": "unicodeCodePoints",  # columns count characters, as in the text output
+        "results": [_sarif_result(d, index[d.rule.code]) for d in kept],
+    }
+    if left_out:
+        run["properties"] = {"truncated": left_out}
+    return json.dumps({"$schema": SARIF_SCHEMA, "version": "2.1.0", "runs": [run]}, indent=2)
+
+
+def _sarif_rule(r) -> dict:
+    return {"id": r.code, "name": r.name, "shortDescription": {"text": r.summary},
+            "fullDescription": {"text": r.explanation}, "help": {"text": r.explanation},
+            "defaultConfiguration": {"level": _SARIF_LEVEL[r.severity]}}
+
+
+def _sarif_result(d: Diagnostic, rule_index: int) -> dict:
+    end_line, end_column = d.end
+    region = {"startLine": d.span.line, "startColumn": d.span.column,
+              "endLine": end_line, "endColumn": end_column}
+    location = {"artifactLocation": {"uri": _uri(d.file)}, "region": region}
+    return {"ruleId": d.rule.code, "ruleIndex": rule_index, "level": _SARIF_LEVEL[d.severity],
+            "message": {"text": d.message}, "locations": [{"physicalLocation": location}]}
+
+
+def _uri(file: str) -> str:
+    """A file as a URI: relative paths stay relative (to the repository, for GitHub)."""
+    import os
+    from pathlib import Path
+    from urllib.parse import quote
+
+    if os.path.isabs(file):
+        return Path(file).as_uri()
+    return quote(file.replace("\\", "/"))
+
+
+def rule_counts(diagnostics: Iterable[Diagnostic]) -> list[tuple[Diagnostic, int]]:
+    """One diagnostic of each rule and severity with its count, most frequent first."""
+    counts: dict[tuple[str, Severity], list] = {}
+    for d in diagnostics:
+        counts.setdefault((d.rule.code, d.severity), [d, 0])[1] += 1
+    return sorted(((d, n) for d, n in counts.values()),
+                  key=lambda dn: (-dn[1], dn[0].rule.code, dn[0].severity))
+
+
+def write_statistics(diagnostics: list[Diagnostic], files: int,
+                     stream: IO[str] | None = None) -> None:
+    """`check --statistics`: how often each rule was found, and the closing count line."""
+    lines: list[Line] = [[
+        (f"{n:>6}  ", "bold"), (d.rule.code, _STYLE[d.severity]),
+        (f"  {d.rule.name:<24}", "dim"), (f"  {d.severity}", ""),
+    ] for d, n in rule_counts(diagnostics)]
+    write_lines([*lines, summary_line(diagnostics, files)], stream)
+
+
+def statistics_json(diagnostics: list[Diagnostic]) -> str:
+    """`check --statistics --output-format json`: {"statistics": [{code, rule, severity, count}]}."""
+    import json
+
+    return json.dumps({"statistics": [
+        {"code": d.rule.code, "rule": d.rule.name, "severity": str(d.severity), "count": n}
+        for d, n in rule_counts(diagnostics)]}, indent=2)
