@@ -16,6 +16,11 @@ instant (goal: well under a second, measured in-process):
 (e) `every 20ms { TT }`: one report a pass, 4 million a day.
 `--short` runs (c)-(e) for less simulated time (for the slow code before the
 fix) and prints the wall time scaled to a simulated day.
+
+Loops whose passes differ by a constant shift of position and target (issue 11,
+item 3), 1500 simulated days each (goal: under 2 s of wall time each):
+(f) `every 10ms { MR 1, WS 0 }`: a scan stepping forever (into the soft limit);
+(g) Example 4 in mode 1 with button 1 held from power-on (`--buttons 1@0`).
 """
 from __future__ import annotations
 
@@ -46,6 +51,13 @@ CASES = {
         ["-", "--until", "1500d"], None),
 }
 LOOP = "[MC00] CN1,WA20,RP,RP\n"
+LONG_MS = 1500 * 24 * 3_600_000
+JOG = "autostart {\n  every 10ms { MR 1, WS 0 }\n}\n"
+SHIFT_CASES = {
+    "every 10ms { MR 1, WS 0 } to 1500d": lambda: measure_source(JOG, LONG_MS),
+    "example 4, mode 1, button 1 held, 1500d": lambda: measure(
+        [EXAMPLE4, "--buttons", "1@0", "--until", "1500d"]),
+}
 # (source, simulated ms, simulated ms with --short)
 DAY_CASES = {
     "goto ping-pong, no wait (busy loop)": (
@@ -110,6 +122,11 @@ def main() -> None:
     count = PRESSES // 5 if short else PRESSES
     wall = presses_at_one_instant(count)
     print(f"{count:,} presses at one instant: {wall:.2f} s wall")
+    for name, case in SHIFT_CASES.items():
+        wall, result = case()
+        final = result["final"]
+        print(f"{name}: simulated {LONG_MS / 1000:,.0f} s in {wall:.2f} s wall "
+              f"-> ratio {LONG_MS / 1000 / wall:,.0f} : 1 (position {final['position']:,})")
     for name, (args, simulated_ms) in CASES.items():
         wall, result = measure(args)
         simulated = simulated_ms if simulated_ms is not None else result["ended_ms"]

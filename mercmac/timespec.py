@@ -1,6 +1,7 @@
 """Durations (`20ms`, `1.5s`, `1500d`) and button scripts (SPEC §5 `--buttons`)."""
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from fractions import Fraction
@@ -65,7 +66,11 @@ class Press:
 
 
 def parse_buttons(spec: str) -> list[Press]:
-    """Parse '1@0-2s,2+3@5s-5.2s,4@7s' into presses (inputs 1-6)."""
+    """Parse '1@0-2s,2+3@5s-5.2s,4@7s' into presses (inputs 1-6), overlaps merged."""
+    return merge(_read_presses(spec))
+
+
+def _read_presses(spec: str) -> list[Press]:
     presses = []
     for item in filter(None, (p.strip() for p in spec.split(","))):
         who, at, when = item.partition("@")
@@ -88,3 +93,29 @@ def parse_buttons(spec: str) -> list[Press]:
             raise TimeSpecError(f"{_quote(item)}: the release time is before the press time")
         presses.append(Press(inputs, t0, t1))
     return presses
+
+
+def merge(presses: list[Press]) -> list[Press]:
+    """One input's overlapping or touching presses as one: `1@1s-2s,1@1.5s-3s` is `1@1s-3s`.
+
+    A button is either held or not: a second press while it is held adds nothing,
+    and only the last release of the merged span lets it go (otherwise the first
+    release would cut the longer press short). Inputs held over the same span
+    stay together; the result is in time order.
+    """
+    spans: dict[int, list[list]] = {}
+    for press in sorted(presses, key=lambda p: p.start_ms):
+        for n in press.inputs:
+            held = spans.setdefault(n, [])
+            last = held[-1] if held else None
+            if last is not None and (last[1] is None or press.start_ms <= last[1]):
+                last[1] = None if press.end_ms is None or last[1] is None \
+                    else max(last[1], press.end_ms)
+            else:
+                held.append([press.start_ms, press.end_ms])
+    together: dict[tuple, list[int]] = {}
+    for n, held in sorted(spans.items()):
+        for start, end in held:
+            together.setdefault((start, end), []).append(n)
+    order = sorted(together, key=lambda span: (span[0], math.inf if span[1] is None else span[1]))
+    return [Press(tuple(together[span]), *span) for span in order]

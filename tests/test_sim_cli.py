@@ -36,7 +36,9 @@ def test_json_truncates_at_10000_and_counts_the_rest(write):
     out = json.loads(result.output)
     passes = 60_000 // 4
     assert len(out["reports"]) == len(out["outputs"]) == 10_000
-    assert out["truncated"] == {"reports": passes - 10_000, "outputs": 2 * passes - 10_000}
+    # SPEC §5: all three counts once any list is cut (the skipped passes add no events)
+    assert out["truncated"] == {"reports": passes - 10_000, "outputs": 2 * passes - 10_000,
+                                "events": 0}
     assert out["hazards"][0]["rule"] == "busy-loop" and out["hazards"][0]["line"] == 1
     assert out["final"]["macro"] == 0 and out["halted"] is False
 
@@ -55,7 +57,7 @@ def test_text_timeline_and_summary_plain_when_piped():
     text = result.output
     assert "\x1b[" not in text
     assert "button 1 pressed" in text and "LEDs ●○○○" in text
-    assert "enter MC20" in text and "move to 100000" in text and "fast-forward" in text
+    assert "goto MC20" in text and "move to 100000" in text and "fast-forward" in text
     assert "Summary: ran to 3.000 s; still running MC20 at the end." in text
 
 
@@ -186,7 +188,7 @@ def test_real_subprocess_text_and_errors():
     done = subprocess.run([sys.executable, "-m", "mercmac", "sim", EXAMPLE4, "--buttons",
                            "3@0-300ms", "--until", "1s"], capture_output=True, text=True,
                           timeout=60)
-    assert done.returncode == 0 and "enter MC26" in done.stdout
+    assert done.returncode == 0 and "goto MC26" in done.stdout
     bad = subprocess.run([sys.executable, "-m", "mercmac", "sim", EXAMPLE4, "--buttons", "x"],
                          capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "mercmac: --buttons" in bad.stderr

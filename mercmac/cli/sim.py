@@ -15,21 +15,32 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
 @click.command()
 @click.argument("file", type=click.Path(dir_okay=False, allow_dash=True))
 @click.option("--buttons", default="", metavar="SPEC",
-              help='Button script: "1@0-2s,2+3@5s-5.2s" (input B held from T1 to T2, or from T1 on).')
+              help='Button script: "1@0-2s,2+3@5s-5.2s" (input B held from T1 to T2, or from T1 on). '
+                   "Overlapping presses of one button merge into one.")
 @click.option("--until", "until", default=None, metavar="DURATION",
               help="How long to simulate: 500ms, 10s, 2h, 1500d.  [default: 10s]")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="A timeline for people or JSON for programs.")
+@click.option("-v", "--verbose", count=True,
+              help="Timeline detail: -v adds macro entries and exits, -vv shows everything.")
 @click.option("--trace", is_flag=True, help="Show every executed instruction, disassembled.")
 @click.option("--vcd", type=click.Path(dir_okay=False), metavar="OUT",
               help="Write a Value Change Dump (GTKWave, Surfer) to OUT.")
 @click.option("--vcd-limit", type=click.FloatRange(min=0), default=100, show_default=True,
               metavar="MB", help="Stop the VCD before it passes this size (0: no limit).")
-@click.option("--interactive", is_flag=True, help="A live pushbutton box: keys 1-4, q quits.")
+@click.option("--plot", type=click.Path(dir_okay=False), metavar="FILE",
+              help="Draw position, buttons, LEDs and macro over time: .png, .svg, .pdf or "
+                   ".html (zooms and pans). Needs the extra: pip install 'mercmac[plot]'.")
+@click.option("--interactive", is_flag=True,
+              help="A live pushbutton box: keys 1-4, r resets (power-on), q quits with a summary.")
+@click.option("--hold", default="", metavar="B[+B]",
+              help="With --interactive: inputs held at power-on, e.g. 2 or 2+3 (mode selection).")
 @click.option("--speed", type=FiniteFloat(), default=1.0, show_default=True,
               help="Simulated seconds per wall-clock second in --interactive.")
 @click.option("--scenario", type=click.Path(dir_okay=False), metavar="FILE.toml",
-              help="Timed button steps and expectations; exit 1 on the first that fails.")
+              help="Timed button steps and expectations; exit 1 on the first that fails. "
+                   "Not with --buttons: the scenario's steps are the button script.")
+@click.option("--fail-on-hazard", is_flag=True, help="Exit 1 when the run finds any hazard (for CI).")
 @click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
 @click.option("--cycle", type=FiniteFloat(), default=1.0, show_default=True, metavar="MS",
               help="Time one executed command takes.")
@@ -40,8 +51,8 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
               help="Position of the reference switch that FE searches for.")
 @click.option("--hard-limits", default=None, metavar="NEG,POS",
               help="Positions of the limit switches, e.g. -200000,200000 (default: none).")
-def sim(file, buttons, until, fmt, trace, vcd, vcd_limit, interactive, speed, scenario, target, cycle,
-        servo_off, reference_at, hard_limits) -> None:
+def sim(file, buttons, until, fmt, verbose, trace, vcd, vcd_limit, plot, interactive, hold, speed, scenario,
+        fail_on_hazard, target, cycle, servo_off, reference_at, hard_limits) -> None:
     """Simulate FILE on a virtual controller with a scripted pushbutton box.
 
     Macro 0 starts at power-on (t = 0). A file with errors is not simulated:
@@ -52,10 +63,11 @@ def sim(file, buttons, until, fmt, trace, vcd, vcd_limit, interactive, speed, sc
 
         request = run.Request(
             file=file, buttons=buttons, until=until, fmt=fmt, trace=trace, vcd=vcd,
-            vcd_limit_mb=vcd_limit,
+            vcd_limit_mb=vcd_limit, plot=plot,
             interactive=interactive, speed=speed, scenario=scenario, target=target,
             cycle_ms=cycle, servo_off=servo_off, reference_at=reference_at,
-            hard_limits=hard_limits)
+            hard_limits=hard_limits, fail_on_hazard=fail_on_hazard, hold=hold,
+            verbose=verbose)
         return EXIT_OK if run.run(request) else EXIT_FAILED
 
     run_guarded(work)

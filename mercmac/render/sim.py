@@ -3,12 +3,14 @@ from __future__ import annotations
 
 import json
 import math
-from typing import IO
+from itertools import islice
+from typing import IO, Iterator
 
 from mercmac.commands import Mnemonic
 from mercmac.render.console import Line, write_lines
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
+from mercmac.sim import record
 from mercmac.sim.record import Folded, Recorder
 from mercmac.sim.simulate import Run
 
@@ -36,6 +38,27 @@ def clock(t_us: float) -> str:
     return f"{int(days)}d {text}" if days else text
 
 
+UNITS = ((86_400e6, "d"), (3_600e6, "h"), (60e6, "min"), (1e6, "s"), (1e3, "ms"))
+
+
+def duration(t_us: float) -> str:
+    """A span for people, 3 significant digits: '39 ms', '1.5 s', '31.7 min', '4.2 d'."""
+    if t_us == math.inf:
+        return "forever"
+    for i, (size, unit) in enumerate(UNITS):
+        value = float(f"{t_us / size:.3g}")
+        if value >= 1 or unit == "ms":
+            if i and value >= UNITS[i - 1][0] / size:  # 59.99 s rounds to 60 s: 1 min
+                return duration(UNITS[i - 1][0])
+            return f"{t_us / size:,.0f} {unit}" if value >= 1000 else f"{value:g} {unit}"
+    return f"{t_us / 1e3:g} ms"  # unreachable: ms catches every span
+
+
+def plural(n: int, noun: str, nouns: str | None = None) -> str:
+    """'1 LED change', '2 hazards', '1,000 reports'."""
+    return f"{n:,} {noun if n == 1 else nouns or noun + 's'}"
+
+
 def lamps(pattern: int) -> Line:
     """The four LEDs, output 1 first, lit ones bold yellow."""
     return [(ON, "bold yellow") if pattern >> i & 1 else (OFF, "dim") for i in range(4)]
@@ -59,9 +82,9 @@ def event_line(event) -> Line | None:
             return _at(t) + [("report ", ""), (text, "bold"), (_where(where), "dim")]
         case ev.HazardFound(t, rule, message, where):
             return _at(t) + [(f"hazard {rule}: ", "bold red"), (message, "red"), (_where(where), "dim")]
-        case ev.MoveStarted(t, kind, target, arrival, _, where):
-            when = f"arrives {clock(arrival)}" if arrival > t else "no motion"
-            return _at(t) + [(f"{kind} to {target} ({when})", "green"), (_where(where), "dim")]
+        case ev.MoveStarted(t, kind, target, arrival, segments, where):
+            return _at(t) + [(_move(t, kind, target, arrival, segments), "green"),
+                             (_where(where), "dim")]
         case ev.MoveEnded(t, how, position):
             text = "on target at" if how == "arrived" else "stopped by the limit switch at"
             return _at(t) + [(f"{text} {position}", "green" if how == "arrived" else "bold red")]
@@ -69,52 +92,131 @@ def event_line(event) -> Line | None:
             return _at(t) + [(f"home defined: position is now {position}", "green"), (_where(where), "dim")]
         case ev.ProgramEnded(t):
             return _at(t) + [("program ended: back in direct mode", "bold")]
-        case ev.FastForwarded(t, t_to, passes, period, loop, shape):
-            return _at(t) + [(f"fast-forward {passes:,} identical passes of {loop.label} "
-                              f"({_span(period)}{_emitted(shape)} each) to {clock(t_to)}",
-                              "magenta"), (_where(loop), "dim")]
+        case ev.FastForwarded(t, t_to, passes, period, loop, shape, _, shift):
+            kind = ("identical pass", "identical passes") if not shift else ("pass", "passes")
+            moved = f", each {shift:+,} counts further" if shift else ""
+            return _at(t) + [(f"fast-forward {plural(passes, *kind)} of {loop.label} "
+                              f"({duration(period)}{_emitted(shape)} each{moved}) "
+                              f"to {clock(t_to)}", "magenta"), (_where(loop), "dim")]
         case Folded():
             return _folded(event)
     return None
 
 
-def _span(t_us: int) -> str:
-    """A pass's length: '22 ms' up to 10 s, then as a clock ('00:24:01.790')."""
-    return f"{t_us / 1000:g} ms" if t_us < 10_000_000 else clock(t_us)
+def _move(t: int, kind: str, target: int, arrival: float, segments: tuple) -> str:
+    """'move to -2000 from 0 (arrives 0.264 s, in 141 ms)'."""
+    if arrival <= t:
+        return f"{kind} to {target} (no motion)"
+    start = f" from {round(segments[0].x0)}" if segments else ""
+    when = "never arrives" if arrival == math.inf else \
+        f"arrives {clock(arrival)}, in {duration(arrival - t)}"
+    return f"{kind} to {target}{start} ({when})"
 
 
 def _emitted(shape: tuple) -> str:
     """', 1 report, 2 LED changes': what each skipped pass emitted (counted in the summary)."""
     reports, changes = ff.count(shape, ff.REPORT), ff.count(shape, ff.OUTPUTS)
-    parts = ([f"{reports:,} report{'s' * (reports != 1)}"] if reports else []) + \
-        ([f"{changes:,} LED change{'s' * (changes != 1)}"] if changes else [])
+    parts = ([plural(reports, "report")] if reports else []) + \
+        ([plural(changes, "LED change")] if changes else [])
     return "".join(f", {part}" for part in parts)
 
 
-def _folded(fold: Folded) -> Line:
+def _flow_text(fold: Folded, entering: bool) -> str:
     e = fold.event
-    if isinstance(e, ev.MacroEntered):
-        text = f"enter {e.label}" + (f" ({e.via})" if e.via != Mnemonic.EM else "")
+    if entering:
+        via = getattr(e, "via", Mnemonic.EM)
+        return f"enter {e.label}" + (f" ({via})" if via != Mnemonic.EM else "")
+    back = f", back to {e.back_to}" if e.back_to else ""
+    why = "ends" if e.why == "end" else e.why if e.why == "stopped" else f"exits on {e.why}"
+    return f"{e.label} {why}{back}"
+
+
+def _mode_text(fold: Folded) -> str:
+    e = fold.event
+    if fold.kind == record.START:
+        return f"{e.via}: {e.label} starts"
+    return f"goto {e.label}" if fold.kind == record.GOTO else f"enter the loop {e.label}"
+
+
+def _folded(fold: Folded) -> Line:
+    """A fold on one line, as `-vv` shows it: at its first time, with its count."""
+    return _fold_lines(fold, 2)[0][1]
+
+
+def _fold_lines(fold: Folded, level: int) -> list[tuple[int, Line]]:
+    """(time, line) for a fold at a verbosity; a repeated one is dated at its last time."""
+    if fold.kind in record.MODES:
+        texts, style = [_mode_text(fold)], "bold blue"
+    elif fold.kind == record.POLL:
+        texts, style = [_flow_text(fold, True), _flow_text(fold, False)], "blue"
     else:
-        back = f", back to {e.back_to}" if e.back_to else ""
-        why = "ends" if e.why == "end" else e.why if e.why == "stopped" else f"exits on {e.why}"
-        text = f"{e.label} {why}{back}"
-    if fold.count > 1:
-        text += f"  x{fold.count:,} until {clock(fold.last_t)}"
-    return _at(e.t) + [(text, "blue")]
+        texts, style = [_flow_text(fold, fold.kind == record.ENTRY)], "blue"
+    if level < (0 if fold.kind in record.MODES else 1 if fold.kind != record.POLL else 2):
+        return []
+    if fold.count == 1:
+        times = [fold.first_t, fold.last_t] if fold.kind == record.POLL else [fold.last_t]
+        return [(t, _at(t) + [(text, style)]) for t, text in zip(times, texts)]
+    counts = [f"  x{fold.count:,} since {clock(fold.first_t)}", f"  x{fold.count:,}"]
+    return [(fold.last_t, _at(fold.last_t) + [(text + count, style)])
+            for text, count in zip(texts, counts)]
+
+
+def _polls(folds: list[Folded]) -> list[tuple[int, Line]]:
+    """`-v`: one line for the polls of a stretch (macros entered only to test a button)."""
+    polls = [f for f in folds if f.kind == record.POLL]
+    if not polls:
+        return []
+    t = max(f.last_t for f in polls)
+    slots = ", ".join(dict.fromkeys(f"MC{f.event.slot:02d}" for f in polls))
+    text = (f"{plural(sum(f.count for f in polls), 'poll')} since "
+            f"{clock(min(f.first_t for f in polls))}: {slots} tested and left")
+    return [(t, _at(t) + [(text, "dim blue")])]
+
+
+def _stretch(folds: list[Folded], level: int) -> list[Line]:
+    """The macro flow between two other events, in time order."""
+    dated = [pair for fold in folds for pair in _fold_lines(fold, level)]
+    if level == 1:
+        dated += _polls(folds)
+    return [line for _, line in sorted(dated, key=lambda pair: pair[0])]
 
 
 def _at(t_us: float) -> Line:
     return [(f"{clock(t_us):>16}  ", "dim")]
 
 
-def timeline(record: Recorder) -> list[Line]:
-    lines = [line for line in map(event_line, record.timeline) if line is not None]
-    hidden = max(len(lines) - TEXT_LIMIT, 0) + record.dropped["timeline"]
+def _story(events: list, level: int) -> Iterator[Line]:
+    """The shown lines: other events as they come, each stretch of folds sorted."""
+    folds: list[Folded] = []
+    for event in events:
+        if isinstance(event, Folded):
+            folds.append(event)
+            continue
+        yield from _stretch(folds, level)
+        folds = []
+        line = event_line(event)
+        if line is not None:
+            yield line
+    yield from _stretch(folds, level)
+
+
+def timeline(rec: Recorder, level: int = 0) -> list[Line]:
+    """The timeline at a verbosity: 0 the story, 1 with macro entries and exits, 2 all."""
+    lines = list(islice(_story(rec.timeline, level), TEXT_LIMIT + 1))
+    hidden = max(len(lines) - TEXT_LIMIT, 0) + rec.dropped["timeline"]
     lines = lines[:TEXT_LIMIT]
     if hidden:
-        lines.append([(f"{'':>16}  ... {hidden:,} more events (see --format json)", "dim")])
+        more = plural(hidden, "more event") if not rec.dropped["timeline"] else "more events"
+        lines.append([(f"{'':>16}  ... {more} (see --format json)", "dim")])
     return lines
+
+
+def ending(run: Run) -> list[Line]:
+    """The timeline's last line when the run stopped at --until with the program running."""
+    if run.halted:
+        return []
+    return _at(run.until_ms * 1000) + [(f"end of the run: {run.machine.chunk.label} "
+                                        "still running", "bold")]
 
 
 def summary(run: Run) -> list[Line]:
@@ -131,9 +233,9 @@ def summary(run: Run) -> list[Line]:
         [("Summary", "bold"), (f": ran to {clock(end)}; {how}.", "")],
         [("  position ", ""), (f"{final['position']}", "bold"), (f", target {final['target']}, "
           f"velocity {final['velocity']}, LEDs ", "")] + lamps(final["outputs"]),
-        [(f"  {len(rec.reports) + rec.dropped['reports']:,} reports, "
-          f"{len(rec.outputs) + rec.dropped['outputs']:,} LED changes, ", ""),
-         (f"{len(rec.hazards)} hazards", "bold red" if rec.hazards else "")],
+        [(f"  {plural(len(rec.reports) + rec.dropped['reports'], 'report')}, "
+          f"{plural(len(rec.outputs) + rec.dropped['outputs'], 'LED change')}, ", ""),
+         (plural(len(rec.hazards), "hazard"), "bold red" if rec.hazards else "")],
     ]
 
 
@@ -148,10 +250,11 @@ def trace(record: Recorder) -> list[Line]:
     return lines
 
 
-def write_text(run: Run, stream: IO[str] | None = None, *, with_trace: bool = False) -> None:
-    """The timeline (or trace) and the summary, for people."""
-    body = trace(run.record) if with_trace else timeline(run.record)
-    write_lines(body + summary(run), stream)
+def write_text(run: Run, stream: IO[str] | None = None, *, with_trace: bool = False,
+               verbose: int = 0) -> None:
+    """The timeline at a verbosity (or the trace) and the summary, for people."""
+    body = trace(run.record) if with_trace else timeline(run.record, verbose) + [ending(run)]
+    write_lines([line for line in body if line] + summary(run), stream)
 
 
 def write_vcd_cut(path: str, limit_mb: float, cut_at: int, stream: IO[str] | None = None) -> None:
@@ -177,16 +280,67 @@ def to_json(run: Run) -> str:
         "reports": [{"t_ms": ms(r.t), "text": r.text} for r in rec.reports],
         "outputs": [{"t_ms": ms(o.t), "pattern": o.pattern} for o in rec.outputs],
         "hazards": [{"t_ms": ms(h.t), "rule": h.rule, "message": h.message,
-                     "macro": h.where.label if h.where else None,
-                     "slot": h.where.slot if h.where else None,
-                     "line": h.where.line if h.where else None} for h in rec.hazards],
+                     **_source(h.where)} for h in rec.hazards],
+        "events": [{"t_ms": ms(e.t), **_event_json(e)} for e in rec.events],
     }
-    if rec.dropped["reports"] or rec.dropped["outputs"]:
-        out["truncated"] = {"reports": rec.dropped["reports"], "outputs": rec.dropped["outputs"]}
-    if rec.trace:
+    if rec.trace:  # --trace: the executed instructions, capped like the lists above
         out["trace"] = [{"t_ms": ms(e.t), "macro": e.where.slot, "line": e.where.line,
-                         "instruction": e.text} for e in rec.trace]
+                         "instruction": e.text, "name": e.where.label}
+                        for e in rec.trace[:JSON_CAP]]
+    truncated = _truncated(rec)
+    if truncated:
+        out["truncated"] = truncated
     return json.dumps(out, indent=2)
+
+
+JSON_CAP = 10_000  # SPEC §5: each JSON list keeps its first 10,000 entries
+
+
+def _truncated(rec: Recorder) -> dict:
+    """SPEC §5 `truncated`: when any list was cut, the counts left out of reports, outputs
+    and events (all three keys, as SPEC §5 shows them), and of the trace when it was cut."""
+    trace = rec.dropped["trace"] + max(len(rec.trace) - JSON_CAP, 0)
+    counts = {key: rec.dropped[key] for key in ("reports", "outputs", "events")}
+    if not (any(counts.values()) or trace):
+        return {}
+    return counts | ({"trace": trace} if trace else {})
+
+
+def _source(where: ev.Where | None) -> dict:
+    """The macro (label), its slot and the source line an event came from; nulls if none."""
+    return {"macro": where.label if where else None, "slot": where.slot if where else None,
+            "line": where.line if where else None}
+
+
+def _event_json(event) -> dict:
+    """One entry of SPEC §5 `events`: its kind, where it came from, and its details."""
+    match event:
+        case ev.InputChanged(_, n, on):
+            return {"kind": "press" if on else "release", "input": n}
+        case ev.OutputsChanged(_, pattern):
+            return {"kind": "output", "pattern": pattern}
+        case ev.Reported(_, text, where):
+            return {"kind": "report", **_source(where), "text": text}
+        case ev.HazardFound(_, rule, message, where):
+            return {"kind": "hazard", **_source(where), "rule": rule, "message": message}
+        case ev.MoveStarted(_, kind, target, arrival, _, where):
+            return {"kind": "move", **_source(where), "motion": kind, "target": target,
+                    "arrival_ms": None if arrival == math.inf else ms(arrival)}
+        case ev.MoveEnded(_, how, position):
+            return {"kind": "arrive" if how == "arrived" else "limit", "position": position}
+        case ev.HomeDefined(_, position, where):
+            return {"kind": "home", **_source(where), "position": position}
+        case ev.MacroEntered(_, slot, label, via):
+            return {"kind": "macro-enter", "macro": label, "slot": slot, "via": via}
+        case ev.MacroLeft(_, slot, label, why, back_to, back_slot):
+            return {"kind": "macro-exit", "macro": label, "slot": slot, "why": why,
+                    "back_to": back_to, "back_slot": back_slot}
+        case ev.ProgramEnded():
+            return {"kind": "program-end"}
+        case ev.FastForwarded(_, t_to, passes, period, loop, _):
+            return {"kind": "fast-forward", **_source(loop), "to_ms": ms(t_to),
+                    "passes": passes, "period_ms": ms(period)}
+    return {"kind": type(event).__name__}
 
 
 def live_status(t_us: float, pattern: int, inputs: list[bool], position: int, target: int,
@@ -194,5 +348,18 @@ def live_status(t_us: float, pattern: int, inputs: list[bool], position: int, ta
     """The one status line of `sim --interactive`, redrawn in place."""
     leds = "".join(ON if pattern >> i & 1 else OFF for i in range(4))
     buttons = " ".join(f"[{n}]" if inputs[n] else f" {n} " for n in range(1, 5))
+    running = macro if macro == "direct mode" else f"running {macro}"
     return (f"{clock(t_us):>12}  LEDs {leds}  buttons {buttons}  position {position:>11}"
-            f"  target {target:>11}  {macro}")
+            f"  target {target:>11}  {running}")
+
+
+def countdown_status(left_s: float, inputs: list[bool]) -> str:
+    """The status line before power-on in `sim --interactive`: which inputs will be held."""
+    held = " ".join(f"[{n}]" for n in range(1, 7) if inputs[n]) or "none"
+    return (f"power-on in {left_s:.1f} s: keys 1-6 choose the buttons held at power-on, "
+            f"Enter powers on now - held: {held}")
+
+
+def reset_line(t_us: float) -> Line:
+    """The line `r` leaves in the interactive box's log."""
+    return _at(t_us) + [("reset: power-on again (like RT); held buttons stay held", "bold")]

@@ -5,27 +5,55 @@ counted), those of fast-forwarded passes too: a skip lists what its passes
 emitted while there is room and counts the rest, so the lists and the totals
 are what plain stepping would give. Macro entries and exits, which a polling
 loop makes by the thousand, are folded: between two other events each (macro,
-what happened) appears once with a count.
+what happened) appears once with a count. A macro entered only to fail its
+first `XN`/`XF` and leave is a poll; entering a macro with a tail `EM` (a
+`goto`) or one that loops for long is a mode change. The timeline shows the
+three apart (render/sim.py: default, `-v`, `-vv`).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 from itertools import islice
 
+from mercmac.commands import Mnemonic
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
+from mercmac.vm.opcodes import Opcode
 
-CAP = 10_000  # SPEC §5: reports and output changes beyond this are counted, not listed
+CAP = 10_000  # SPEC §5: reports, output changes and events beyond this are counted, not listed
 TIMELINE_CAP = 100_000
+LONG_LOOP = 1000  # an RP repeating this often or more makes a macro a mode, not a step
+
+ENTRY, POLL, LEFT = "entry", "poll", "left"
+START, GOTO, LOOP = "start", "goto", "loop"  # mode changes: power-on or host, tail EM, long loop
+MODES = (START, GOTO, LOOP)
 
 
 @dataclass(slots=True)
 class Folded:
-    """A macro entered (or left the same way) `count` times from `event.t` to `last_t`."""
+    """A macro entered (or left the same way) `count` times from `first_t` to `last_t`.
+
+    kind: ENTRY, a mode change (START, GOTO, LOOP), POLL (entered and left at its
+    first failed condition: `event` is the exit, `first_t` the first entry) or LEFT.
+    """
 
     event: ev.MacroEntered | ev.MacroLeft
     count: int
     last_t: int
+    kind: str = ENTRY
+    first_t: int = 0
+
+
+def modes(chunks: dict) -> tuple[set[tuple[int, int]], set[int]]:
+    """The (caller, callee) pairs only ever reached by a tail EM, and the long-loop slots."""
+    tail, inner, loops = set(), set(), set()
+    for slot, chunk in chunks.items():
+        for i, (op, arg) in enumerate(chunk.code):
+            if op == Opcode.EM:
+                (tail if i == len(chunk.code) - 1 else inner).add((slot, arg))
+            elif op == Opcode.RP and (arg or 0) >= LONG_LOOP:
+                loops.add(slot)
+    return tail - inner, loops
 
 
 class Recorder:
@@ -37,14 +65,24 @@ class Recorder:
         self.hazards: list[ev.HazardFound] = []
         self.timeline: list = []
         self.trace: list[ev.Executed] = []
-        self.dropped = {"reports": 0, "outputs": 0, "timeline": 0, "trace": 0}
+        self.events: list = []  # every event but Executed, unfolded, for JSON (SPEC §5 `events`)
+        self.dropped = {"reports": 0, "outputs": 0, "timeline": 0, "trace": 0, "events": 0}
         self.ended_at: int | None = None
         self._folds: dict[tuple, Folded] = {}
+        self._gotos: set[tuple[int, int]] = set()
+        self._loops: set[int] = set()
+        self._current: int | None = None  # the running macro's slot, as the events tell it
+        self._entered: Folded | None = None  # the entry just made, while nothing else happened
+
+    def know(self, chunks: dict) -> None:
+        """Learn the program's gotos and long loops (the machine's assembled chunks)."""
+        self._gotos, self._loops = modes(chunks)
 
     def on_event(self, event) -> None:
         if isinstance(event, ev.Executed):
             self._keep(self.trace, event, "trace")
             return
+        self._keep(self.events, event, "events")
         if isinstance(event, (ev.MacroEntered, ev.MacroLeft)):
             self._flow(event)
             return
@@ -59,6 +97,7 @@ class Recorder:
         elif isinstance(event, ev.FastForwarded) and event.shape:
             self._skipped(event)
         self._folds.clear()
+        self._entered = None
         self._keep(self.timeline, event, "timeline")
 
     def _skipped(self, skip: ev.FastForwarded) -> None:
@@ -69,23 +108,55 @@ class Recorder:
             if total:
                 listed = len(into)
                 room = max(CAP - listed, 0)
-                into.extend(islice(ff.expand(skip.shape, skip.t, skip.period, skip.passes, kind),
+                into.extend(islice(ff.expand(skip.shape, skip.t, skip.period, skip.passes, kind,
+                                            skip.position, skip.shift),
                                    room))
                 self.dropped[what] += total - (len(into) - listed)
 
     def _keep(self, into: list, event, what: str) -> None:
-        if len(into) < (CAP if what in ("reports", "outputs") else TIMELINE_CAP):
+        if len(into) < (CAP if what in ("reports", "outputs", "events") else TIMELINE_CAP):
             into.append(event)
         else:
             self.dropped[what] += 1
 
     def _flow(self, event: ev.MacroEntered | ev.MacroLeft) -> None:
+        entered, self._entered = self._entered, None
         if isinstance(event, ev.MacroEntered):
             self.ended_at = None
-        key = (type(event), event.slot, getattr(event, "why", ""))
+            kind = self._entry_kind(event)
+            self._current = event.slot
+            self._entered = self._fold((kind, event.slot, ""), event, kind, event.t)
+            return
+        self._current = event.back_slot
+        if entered is not None and entered.kind == ENTRY and event.why[:2] in (Mnemonic.XN, Mnemonic.XF):
+            self._unfold(entered)
+            self._fold((POLL, event.slot, event.why), event, POLL, entered.last_t)
+        else:
+            self._fold((LEFT, event.slot, event.why), event, LEFT, event.t)
+
+    def _entry_kind(self, event: ev.MacroEntered) -> str:
+        if event.via != Mnemonic.EM:
+            return START
+        if (self._current, event.slot) in self._gotos:
+            return GOTO
+        return LOOP if event.slot in self._loops else ENTRY
+
+    def _fold(self, key: tuple, event, kind: str, first_t: int) -> Folded:
         fold = self._folds.get(key)
         if fold is None:
-            fold = self._folds[key] = Folded(event, 0, event.t)
+            fold = self._folds[key] = Folded(event, 0, event.t, kind, first_t)
             self._keep(self.timeline, fold, "timeline")
         fold.count += 1
         fold.last_t = event.t
+        return fold
+
+    def _unfold(self, fold: Folded) -> None:
+        """Take back the last count of an entry that turned out to be a poll."""
+        fold.count -= 1
+        if fold.count:
+            return
+        del self._folds[(fold.kind, fold.event.slot, "")]
+        if self.timeline and self.timeline[-1] is fold:
+            self.timeline.pop()
+        else:
+            self.dropped["timeline"] -= 1

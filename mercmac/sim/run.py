@@ -1,6 +1,7 @@
 """What `mercmac sim` does, as a library: compile, simulate one way or another, render."""
 from __future__ import annotations
 
+import os
 import sys
 from dataclasses import dataclass
 
@@ -23,6 +24,7 @@ class Request:
     trace: bool = False
     vcd: str | None = None
     vcd_limit_mb: float = 100  # 0: no limit
+    plot: str | None = None  # FILE.png|.svg|.pdf|.html
     interactive: bool = False
     speed: float = 1.0
     scenario: str | None = None
@@ -31,6 +33,9 @@ class Request:
     servo_off: bool = False
     reference_at: int = 0
     hard_limits: str | None = None
+    verbose: int = 0  # timeline: 0 the story, 1 with macro entries and exits, 2 everything
+    fail_on_hazard: bool = False
+    hold: str = ""  # --interactive: inputs held at power-on, e.g. "2" or "2+3"
 
 
 def run(req: Request) -> bool:
@@ -49,8 +54,19 @@ def run(req: Request) -> bool:
 
 def _run(req: Request) -> bool:
     presses = _presses(req.buttons)
+    if req.scenario and presses:  # two button scripts for one run: which one wins is a guess
+        raise UsageError("--scenario and --buttons cannot be used together: the scenario's "
+                         "[[step]] tables are its button script; add the presses there "
+                         "(at = \"1s\", press = [1], then release = [1])")
+    hold = _hold(req)
     if req.vcd:  # a path that cannot be written is refused before any work (exit 2)
         writable_target(req.vcd)
+    if req.plot:  # and so is a plot that cannot be drawn: a bad path, no matplotlib
+        if req.interactive:
+            raise UsageError("--plot does not go with --interactive (a live session has no end to draw)")
+        from mercmac.sim import plot
+
+        plot.check_target(req.plot)
     options = Options(servo_on=not req.servo_off, reference_at=req.reference_at,
                       hard_limits=_limits(req.hard_limits))
     program = _compile(req)
@@ -63,23 +79,78 @@ def _run(req: Request) -> bool:
 
         machine = Machine(program, **common)
         schedule(machine, presses)
-        return interactive.run(machine, speed=req.speed) == 0
+        hazards = interactive.run(machine, speed=req.speed, hold=hold)
+        return _hazards_ok(req, hazards)
     if req.scenario:
         return _scenario(req, program, presses, common)
     until = _until(req.until, None)
     result = _simulate(req, program, presses, until, common)
     _render(req, result)
-    return True
+    if result.interrupted:  # Ctrl-C: the timeline so far and the summary, then exit 130
+        raise KeyboardInterrupt
+    return _hazards_ok(req, len(result.record.hazards))
+
+
+def _hazards_ok(req: Request, hazards: int) -> bool:
+    """False (exit 1) under --fail-on-hazard when the run found any hazard; says so on stderr."""
+    if not (req.fail_on_hazard and hazards):
+        return True
+    sys.stderr.write(f"mercmac: {hazards} hazard{'s' * (hazards != 1)} found (--fail-on-hazard)\n")
+    return False
+
+
+def _hold(req: Request) -> tuple[int, ...]:
+    """--hold: the inputs held at power-on, only for --interactive."""
+    if not req.hold:
+        return ()
+    if not req.interactive:
+        raise UsageError("--hold is for --interactive; in a script, press at 0: "
+                         f"--buttons \"{req.hold.strip()}@0-500ms\"")
+    try:
+        (press,) = parse_buttons(f"{req.hold}@0")
+    except (TimeSpecError, ValueError):
+        raise UsageError(f"--hold '{req.hold}': inputs are numbers 1-6 joined by '+', "
+                         "e.g. --hold 2 or --hold 2+3") from None
+    return press.inputs
 
 
 def _simulate(req: Request, program, presses, until: int, common: dict) -> Run:
+    watch = _watch(req)
+    result = _simulate_with(req, program, presses, until,
+                            dict(common, watch=watch, progress=_progress(until)))
+    _plot(req, watch, until * 1000)
+    return result
+
+
+def _progress(until_ms: int):
+    """A progress line on stderr for a long run, when stderr is a terminal."""
+    if not sys.stderr.isatty():
+        return None
+    from mercmac.render.progress import ProgressLine
+
+    return ProgressLine(sys.stderr, until_ms)
+
+
+class _Interrupted(Exception):
+    """Ctrl-C cut a run with a VCD: leave the old file, show the run so far."""
+
+    def __init__(self, result: Run):
+        self.result = result
+
+
+def _simulate_with(req: Request, program, presses, until: int, common: dict) -> Run:
     if not req.vcd:
         return simulate(program, presses=presses, until_ms=until, trace=req.trace, **common)
     # the old file stays until the new one is complete; Ctrl-C or an error leaves no temp
     limit = round(req.vcd_limit_mb * 1_000_000) if req.vcd_limit_mb else None
-    with replacing(req.vcd, encoding="ascii") as vcd:
-        result = simulate(program, presses=presses, until_ms=until, trace=req.trace,
-                          vcd=vcd, vcd_limit=limit, **common)
+    try:
+        with replacing(req.vcd, encoding="ascii") as vcd:
+            result = simulate(program, presses=presses, until_ms=until, trace=req.trace,
+                              vcd=vcd, vcd_limit=limit, **common)
+            if result.interrupted:  # a cut dump does not replace the old file
+                raise _Interrupted(result)
+    except _Interrupted as cut:
+        return cut.result
     if result.vcd_cut_at is not None:
         from mercmac.render import sim as render
 
@@ -93,18 +164,40 @@ def _scenario(req: Request, program, presses, common: dict) -> bool:
     plan = scenario.load(req.scenario)
     until = _until(req.until, plan.until_ms)
     machine, record = machine_for(program, trace=req.trace, **common)
+    watch = _watch(req)
+    if watch is not None:
+        watch.then, machine.on_event = machine.on_event, watch.on_event
     schedule(machine, presses)
     try:
         checked = scenario.run(machine, plan, until)
     except scenario.ScenarioFailed:
+        _plot(req, watch, round(machine.now_ms * 1000))
         _render(req, Run(machine, record, round(machine.now_ms)))
         raise
+    _plot(req, watch, until * 1000)
     _render(req, Run(machine, record, until))
     if req.fmt == "text":
         from mercmac.render import sim as render
 
         render.write_scenario_passed(req.scenario, checked, sys.stdout)
-    return True
+    return _hazards_ok(req, len(record.hazards))
+
+
+def _watch(req: Request):
+    """The plot's listener when --plot asks for one."""
+    if not req.plot:
+        return None
+    from mercmac.sim import plot
+
+    return plot.PlotObserver()
+
+
+def _plot(req: Request, watch, end_us: int) -> None:
+    if watch is not None:
+        from mercmac.sim import plot
+
+        title = f"mercmac sim {os.path.basename(req.file)}"
+        plot.write(req.plot, watch.close(end_us), title)
 
 
 def _render(req: Request, result: Run) -> None:
@@ -113,7 +206,7 @@ def _render(req: Request, result: Run) -> None:
     if req.fmt == "json":
         sys.stdout.write(render.to_json(result) + "\n")
     else:
-        render.write_text(result, sys.stdout, with_trace=req.trace)
+        render.write_text(result, sys.stdout, with_trace=req.trace, verbose=req.verbose)
 
 
 def _compile(req: Request):

@@ -6,17 +6,25 @@
     press = [3]                  # and/or release = [3]
     [[expect]]                   # at one time ...
     at = "250ms"
-    macro = 26                   # a macro number, or "none" for direct mode
+    macro = 26                   # a macro number, a macro name, or "none" for direct mode
     [[expect]]                   # ... or at some time within a window
     within = ["1s", "2s"]
     outputs = 1                  # the 4-bit LED pattern (bit 0 = LED 1)
     position = [3990, 4010]      # exact, or an inclusive range
 
 The first expectation that fails ends the run with its reason (exit 1).
+
+A macro name matches the macro of that name in the source and the parts the
+compiler hoisted out of it into slots of their own (`run` matches `run`,
+`run.when@20`, `run.every@19`, ...): a name says which of the user's macros is
+at work, whichever of its slots runs. A name the program does not have is
+refused before the run, with the nearest one. A misspelled key is named, with
+the nearest valid key.
 """
 from __future__ import annotations
 
 import codecs
+import difflib
 import json
 import os
 import stat
@@ -116,10 +124,7 @@ def parse(path: str, data: dict) -> Scenario:
 
 
 def _parse(path: str, data: dict) -> Scenario:
-    unknown = set(data) - {"until", "step", "expect"}
-    if unknown:
-        raise ScenarioError(f"unknown key(s) {', '.join(sorted(map(str, unknown)))}: "
-                            "use until, [[step]], [[expect]]")
+    _refuse_unknown("", data, ("until", "step", "expect"), "use until, [[step]], [[expect]]")
     until = _duration("until", data["until"]) if "until" in data else None
     steps = [_step(i, s) for i, s in enumerate(_tables("step", data), 1)]
     expects = [_expect(i, e) for i, e in enumerate(_tables("expect", data), 1)]
@@ -165,18 +170,32 @@ def _inputs(name: str, value) -> tuple[int, ...]:
     return tuple(values)
 
 
+def _refuse_unknown(where: str, raw: dict, valid: tuple[str, ...], use: str) -> None:
+    """Name the first key that is not one of `valid`, with the nearest valid one."""
+    unknown = sorted(str(k) for k in raw if k not in valid)
+    if not unknown:
+        return
+    key = unknown[0]
+    near = difflib.get_close_matches(key.lower(), valid, n=1, cutoff=0.6)
+    hint = f"did you mean {near[0]!r}? " if near else ""
+    more = f" (and {len(unknown) - 1} more)" if len(unknown) > 1 else ""
+    raise ScenarioError(f"{where}unknown key {_show(key)}{more}: {hint}{use}")
+
+
 def _step(i: int, raw: dict) -> Step:
-    unknown = set(raw) - {"at", "press", "release"}
-    if "at" not in raw or unknown:
-        extra = f" (unknown: {', '.join(sorted(unknown))})" if unknown else ""
+    _refuse_unknown(f"step {i}: ", raw, ("at", "press", "release"),
+                    "a step has at, press and release")
+    if "at" not in raw:
         raise ScenarioError(f"step {i}: write at = \"1s\" with press = [..] and/or "
-                            f"release = [..]{extra}")
+                            "release = [..]")
     return Step(_duration(f"step {i}: at", raw["at"]),
                 _inputs(f"step {i}: press", raw.get("press", [])),
                 _inputs(f"step {i}: release", raw.get("release", [])))
 
 
 def _expect(i: int, raw: dict) -> Expect:
+    _refuse_unknown(f"expect {i}: ", raw, ("at", "within") + CHECKS,
+                    f"an expectation has at or within, and {', '.join(CHECKS)}")
     checks = {k: v for k, v in raw.items() if k in CHECKS}
     timing = set(raw) - set(checks)
     if not checks or timing not in ({"at"}, {"within"}):
@@ -202,8 +221,8 @@ EXPECTED = {  # what each check takes, and how to say so
     "position": (lambda v: _whole(v) or (isinstance(v, list) and len(v) == 2
                                          and all(map(_whole, v)) and v[0] <= v[1]),
                  "a whole number, or a range [low, high] with low <= high"),
-    "macro": (lambda v: v == "none" or (_whole(v) and 0 <= v <= 31),
-              'a macro number 0-31, or "none" for direct mode'),
+    "macro": (lambda v: (isinstance(v, str) and v.strip() != "") or (_whole(v) and 0 <= v <= 31),
+              'a macro number 0-31, a macro name, or "none" for direct mode'),
     "running": (lambda v: isinstance(v, bool), "true or false"),
 }
 
@@ -227,6 +246,33 @@ def _show(value, limit: int = 40) -> str:
     return text if len(text) <= limit else f"{text[:limit - 12]}...{text[-9:]}"
 
 
+def _names(m: Machine) -> set[str]:
+    """The macro names a scenario may use: each slot's name and the macros it was hoisted from."""
+    names = set()
+    for chunk in m.chunks.values():
+        parts = chunk.name.split(".")
+        names.update(".".join(parts[:k]) for k in range(1, len(parts) + 1))
+    return names - {""}
+
+
+def _is_named(name: str | None, want: str) -> bool:
+    """`run` names the macro run and the parts hoisted out of it (`run.when@20`)."""
+    return name is not None and (name == want or name.startswith(want + "."))
+
+
+def check_names(m: Machine, scenario: Scenario) -> None:
+    """Refuse a macro name that the program does not have, with the nearest one."""
+    names = _names(m)
+    for expect in scenario.expects:
+        want = expect.checks.get("macro")
+        if isinstance(want, str) and want != "none" and want not in names:
+            near = difflib.get_close_matches(want, sorted(names), n=1, cutoff=0.6)
+            hint = f"; did you mean {near[0]!r}?" if near else \
+                f"; it has {', '.join(sorted(names)) or 'no named macros'}"
+            raise ScenarioError(f"{scenario.name}: expect {expect.number}: macro = {_show(want)}: "
+                                f"the program has no macro of that name{hint}")
+
+
 def mismatch(m: Machine, checks: dict) -> str | None:
     """Why the machine does not meet the checks now, or None if it does."""
     actual = {"outputs": m.outputs_pattern(), "position": m.position(),
@@ -235,6 +281,9 @@ def mismatch(m: Machine, checks: dict) -> str | None:
         have = actual[key]
         if key == "position" and isinstance(want, list):
             good = want[0] <= have <= want[1]
+        elif key == "macro" and isinstance(want, str) and want != "none":
+            good = m.macro is not None and _is_named(m.chunk.name, want)
+            have = m.label if m.macro is not None else "none"
         else:
             good = have == want
         if not good:
@@ -272,6 +321,7 @@ def next_change_ms(m: Machine) -> float:
 
 def run(m: Machine, scenario: Scenario, until_ms: int) -> int:
     """Power on, play the steps, check every expectation in time order; the number checked."""
+    check_names(m, scenario)
     schedule_steps(m, scenario)
     m.power_on()
     for expect in sorted(scenario.expects, key=lambda e: (e.start_ms, e.number)):

@@ -1,6 +1,7 @@
 """One scripted simulation: power on, press buttons on schedule, run to a time (SPEC §5 `sim`)."""
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from typing import IO, Iterable
 
@@ -21,6 +22,7 @@ class Run:
     record: Recorder
     until_ms: int
     vcd_cut_at: int | None = None  # us: where the VCD stopped at its size limit
+    interrupted: bool = False  # Ctrl-C stopped it at until_ms: the record is what came so far
 
     @property
     def halted(self) -> bool:
@@ -53,16 +55,20 @@ def machine_for(program: Program, *, model: str | None = None, cycle_ms: float =
     record = Recorder()
     machine = Machine(program, model=model, cycle_ms=cycle_ms, options=options,
                       on_event=record.on_event, trace=trace, fast_forward=fast_forward)
+    record.know(machine.chunks)
     return machine, record
 
 
 def simulate(program: Program, *, presses: Iterable[Press] = (), until_ms: int = DEFAULT_UNTIL_MS,
              model: str | None = None, cycle_ms: float = 1.0, options: Options | None = None,
              trace: bool = False, vcd: IO[str] | None = None,
-             vcd_limit: int | None = None) -> Run:
+             vcd_limit: int | None = None, watch=None, progress=None) -> Run:
     """Power on at t = 0 (macro 0 starts, SPEC §3 Power-on) and run to until_ms.
 
     A VCD stops (a valid file) before it would pass `vcd_limit` bytes; the run goes on.
+    `watch` is one more listener (a plot) with `on_event` and `then`; it sees every event first.
+    `progress` (`update(now_ms)`, `close()`) hears the simulated time reached as the run goes.
+    Ctrl-C (KeyboardInterrupt) ends the run where it is: the Run is marked `interrupted`.
     """
     machine, record = machine_for(program, model=model, cycle_ms=cycle_ms, options=options,
                                   trace=trace)
@@ -72,10 +78,37 @@ def simulate(program: Program, *, presses: Iterable[Press] = (), until_ms: int =
 
         dump = VcdObserver(vcd, record.on_event, vcd_limit)
         machine.on_event = dump.on_event
+    if watch is not None:
+        watch.then, machine.on_event = machine.on_event, watch.on_event
     schedule(machine, presses)
     machine.power_on()
-    machine.run_until(until_ms)
+    interrupted = False
+    try:
+        if progress is None:
+            machine.run_until(until_ms)
+        else:
+            run_reporting(machine, until_ms, progress.update)
+    except KeyboardInterrupt:
+        interrupted, until_ms = True, machine.now_ms
+    finally:
+        if progress is not None:
+            progress.close()
     if dump is None:
-        return Run(machine, record, until_ms)
+        return Run(machine, record, until_ms, interrupted=interrupted)
     dump.close(round(until_ms * 1000))
-    return Run(machine, record, until_ms, dump.cut_at)
+    return Run(machine, record, until_ms, dump.cut_at, interrupted)
+
+
+SLICE_S = 0.1  # wall time per slice of a run that reports progress
+
+
+def run_reporting(machine: Machine, until_ms: float, update) -> None:
+    """Run to until_ms in slices of about SLICE_S of wall time, calling update(now_ms) after
+    each. The slices change what is skipped at once, not what happens (fastforward.py)."""
+    step = 1.0
+    while machine.now_ms < until_ms:
+        began = time.perf_counter()
+        machine.run_until(min(until_ms, machine.now_ms + step))
+        spent = time.perf_counter() - began
+        step = step * 2 if spent < SLICE_S / 2 else max(step / 2, 1.0) if spent > SLICE_S else step
+        update(machine.now_ms)

@@ -113,6 +113,8 @@ class FastForwarded:
     period: int
     loop: Where
     shape: tuple = ()
+    position: int = 0  # a shifted skip (fastforward.moved_shape): the first pass's start position
+    shift: int = 0  # and how much further each next pass starts; 0: passes identical
 
 
 @dataclass(frozen=True, slots=True)

@@ -20,7 +20,8 @@ from mercmac.vm import reports
 from mercmac.vm.assemble import DIRECT, Chunk, assemble, assemble_ops
 from mercmac.vm.clock import Clock
 from mercmac.vm.disasm import instruction
-from mercmac.vm.fastforward import Anchor, Anchors, Loop, Visit, same_pass, skippable
+from mercmac.vm.fastforward import (Anchor, Anchors, Loop, Mark, Visit, same_pass,
+                                    same_shifted_pass, shifted_passes, skippable)
 from mercmac.vm.hazards import HazardLog
 from mercmac.vm.lines import Inputs, Outputs
 from mercmac.vm.models import DEFAULTS, Options, model_name
@@ -33,6 +34,10 @@ JT_US = 2_000_000  # §6.4 JT: "Executing the JT command takes about 2 seconds"
 BUSY_PASSES = 1000  # a loop without waits this long (or endless) is a busy loop hazard
 LOG_LIMIT = 100_000  # effects kept for comparing passes; a longer pass is not skipped
 FAST_FORWARD = ("off", "quiet", "all")  # skip no passes, passes that emit nothing, or any
+
+# reports that show the position (fastforward.Mark): TP, TD, TT shift with it; TE and TV
+# do not at rest; TS shows the limit and reference switches; all but TT vary while moving
+POSITIONAL = {Mnemonic.TP, Mnemonic.TD, Mnemonic.TT, Mnemonic.TE, Mnemonic.TV, Mnemonic.TS}
 
 # §6.4 TS error codes
 E_WRONG_COMMAND, E_HARD_STOP, E_SERVO_OFF, E_JOYSTICK = 0x06, 0x07, 0x0A, 0x0B
@@ -383,8 +388,11 @@ class Machine:
                 self.params[arg[0]] = arg[1] if arg[1] is not None else COMMANDS[arg[0]].default or 0
             case Opcode.REPORT if arg[0] == Mnemonic.TS:
                 self._report(self.read_status())
+                self._mark_report(Mnemonic.TS)
             case Opcode.REPORT:
                 self._report(reports.report(arg[0], arg[1], self))
+                if arg[0] in POSITIONAL:
+                    self._mark_report(arg[0])
             case Opcode.RT:
                 self.power_on()
             case Opcode.RZ | Opcode.RM | Opcode.RMALL:
@@ -476,6 +484,7 @@ class Machine:
                                 "send MN first")
         clamped = min(max(target, self.axis.jl), self.axis.jh, MAX_POSITION)
         clamped = max(clamped, -MAX_POSITION)
+        self._log.append(Mark(ff.REQUESTED, (target, *self._soft_range())))
         if clamped != target:
             side = "upper" if clamped < target else "lower"
             self._hazard("soft-limit-clamp",
@@ -490,6 +499,9 @@ class Machine:
     def _motion(self, kind: str, command: Callable[[float], None]) -> None:
         """Run an axis command now and tell the observer about the new profile."""
         t = self.clock.now
+        axis = self.axis
+        if axis.segs or axis.stalled or not float(axis.final).is_integer():
+            self._log.append(Mark(ff.UNSHIFTABLE))  # not from rest on a count: floats differ
         command(t)
         self.mover = self._where(self.ip - 1)  # the command a limit hit will be blamed on
         self._emit(ev.MoveStarted(t, kind, self.axis.target,
@@ -553,6 +565,8 @@ class Machine:
         else:
             self.trigger.increment = value
         self.trigger.rearm()
+        if self.trigger.mode:  # pulses at positions: not counted as boundaries
+            self._log.append(Mark(ff.UNSHIFTABLE))
 
     def _joystick_table(self, table: int) -> None:
         self.params[Mnemonic.JT] = table
@@ -564,6 +578,22 @@ class Machine:
         self._emit(ev.Reported(t, text, self._where(self.ip - 1)))
         if self.on_report:
             self.on_report(t / 1000, text)
+
+    def _mark_report(self, mnemonic: str) -> None:
+        """Note how the report just made depends on the position (fastforward.moved_shape)."""
+        axis = self.axis
+        if mnemonic == Mnemonic.TT:
+            self._log.append(Mark(ff.PLACED, (COMMANDS[mnemonic].report, axis.target)))
+        elif axis.segs or axis.stalled or not float(axis.final).is_integer():
+            self._log.append(Mark(ff.UNSHIFTABLE))
+        elif mnemonic == Mnemonic.TS:
+            self._log.append(Mark(ff.ABSOLUTE))
+        elif mnemonic in (Mnemonic.TP, Mnemonic.TD):
+            self._log.append(Mark(ff.PLACED, (COMMANDS[mnemonic].report, int(axis.final))))
+
+    def _soft_range(self) -> tuple[int, int]:
+        """Where a target is not clamped: the soft limits within the 32-bit range (§4.4.2)."""
+        return max(self.axis.jl, -MAX_POSITION), min(self.axis.jh, MAX_POSITION)
 
     def _remove(self, opcode: Opcode, slot: int | None) -> None:
         """RZ, RM n, RM, RMALL (§6.4): erase stored macros; RMALL resets parameters too."""
@@ -611,6 +641,7 @@ class Machine:
             self._drive_joystick()
 
     def _pulse(self, t: int) -> None:
+        self._log.append(Mark(ff.UNSHIFTABLE))
         self.trigger.fire(t)
         self.outputs.pulse_until = t + PULSE_US
         self._outputs_changed()
@@ -636,13 +667,31 @@ class Machine:
             self._busy_loop(anchor, key, previous, remaining)
         visit = self._visit(key, previous)
         self.anchors.arrive(anchor, visit)
-        if previous is None or self.fast_forward == "off" or not same_pass(previous, visit):
+        if previous is None or self.fast_forward == "off":
+            return
+        if not same_pass(previous, visit):
+            if self.fast_forward == "all" and same_shifted_pass(previous, visit):
+                self._skip_shifted(anchor, own, previous, visit, remaining)
             return
         if visit.shape and self.fast_forward != "all":
             return
         passes = skippable(previous, visit, min(self._horizon, self._next_hardware()), remaining)
         if passes > 0:
             self._skip(anchor, own, passes, visit.wake - previous.wake, visit)
+
+    def _skip_shifted(self, anchor: Anchor, own: int | None, previous: Visit, visit: Visit,
+                      remaining: float) -> None:
+        """Skip passes that repeat `visit.delta` further on, up to the next boundary."""
+        period = visit.wake - previous.wake
+        fit = skippable(previous, visit, min(self._horizon, self._next_hardware()), remaining)
+        hard = self.options.hard_limits
+        if hard is not None:
+            hard = (hard[0] + self.axis.shift, hard[1] + self.axis.shift)
+        passes = shifted_passes(visit, period, fit, self._soft_range(), hard)
+        if passes < fit:  # a boundary, not the counter, ends it: enclosing passes differ
+            self._log.append(Mark(ff.UNSHIFTABLE))
+        if passes > 0:
+            self._skip(anchor, own, passes, period, visit, visit.delta)
 
     def _busy_loop(self, anchor: Anchor, key: tuple | None, previous: Visit,
                    remaining: float) -> None:
@@ -659,28 +708,51 @@ class Machine:
         if len(self._log) > LOG_LIMIT:  # passes this long are not compared
             self._log_base += len(self._log)
             self._log.clear()
-        pass_shape = None
-        if (previous is not None and key is not None and key == previous.key
-                and previous.logged >= self._log_base):
+        pass_shape = moved = delta = None
+        whole = previous is not None and previous.logged >= self._log_base
+        if whole and key is not None and key == previous.key:
             pass_shape = ff.shape(self._log[previous.logged - self._log_base:], previous.wake)
+        skey, position = self._shift_key(key)
+        if (whole and pass_shape is None and skey is not None and skey == previous.skey
+                and self.fast_forward == "all"):
+            delta = position - previous.position
+            moved = ff.moved_shape(self._log[previous.logged - self._log_base:],
+                                   previous.wake, previous.position)
         return Visit(key, self.wake, self.inputs.version, self.waits,
-                     self._log_base + len(self._log), pass_shape)
+                     self._log_base + len(self._log), pass_shape, skey, position, delta, moved)
+
+    def _shift_key(self, key: tuple | None) -> tuple[tuple | None, int]:
+        """The state key without the axis's position and target, and the target; (None, 0)
+        unless the axis rests on its target, a whole count, with no trigger set."""
+        axis = self.axis
+        if key is None or axis.final != axis.target or self.trigger.mode:
+            return None, 0
+        axis_key = key[-2]  # Axis.STATE_KEY: segs, final, target, ...
+        return key[:-2] + (axis_key[:1] + axis_key[3:], key[-1]), axis.target
 
     def _skip(self, anchor: Anchor, own: int | None, passes: int, period: int,
-              visit: Visit) -> None:
-        """Skip `passes` copies of the pass that ended at `visit`; the clock jumps exactly."""
-        start = self.wake
+              visit: Visit, shift: int = 0) -> None:
+        """Skip `passes` copies of the pass that ended at `visit`, each `shift` further on
+        than the last; the clock, the position and the target jump exactly."""
+        start, position = self.wake, visit.position
+        shape = visit.moved if shift or visit.shape is None else visit.shape
         self.wake += passes * period
         if own is not None:
             self.counters[self.chunk.slot][own] -= passes
+        if shift:  # at rest on the target (_shift_key): both move on by whole counts
+            self.axis.target += passes * shift
+            self.axis.final = float(self.axis.target)
         if self.on_report is not None:  # the host hears every report (mercmac emulate)
-            for r in ff.expand(visit.shape, start, period, passes, ff.REPORT):
+            for r in ff.expand(shape, start, period, passes, ff.REPORT, position, shift):
                 self.on_report(r.t / 1000, r.text)
         self._emit(ev.FastForwarded(start, self.wake, passes, period,
-                                    self._where_anchor(anchor), visit.shape))
+                                    self._where_anchor(anchor), shape, position, shift))
         # after the skip's own event: it belongs to enclosing loops, not to the next pass
-        self.anchors.arrive(anchor, Visit(visit.key, self.wake, self.inputs.version, self.waits,
-                                          self._log_base + len(self._log), visit.shape))
+        key = self._state_key(own)
+        skey, now = self._shift_key(key)
+        self.anchors.arrive(anchor, Visit(key, self.wake, self.inputs.version, self.waits,
+                                          self._log_base + len(self._log), visit.shape,
+                                          skey, now, visit.delta, visit.moved))
 
     def _state_key(self, own: int | None) -> tuple | None:
         """The whole machine state except the clock and the jumping RP's own counter
