@@ -137,9 +137,11 @@ Calls, XN/XF conditions and TI cannot move, and a raw `[MCnn]` block is kept
 exactly as written. Move part of the work into a macro of its own and call it,
 or shorten the block.""", {
         "": _TOO_MANY,
-        "unsplittable": _TOO_MANY + ", and it cannot be split: its RP repeats the whole line, "
-                        "and what it holds cannot move into a called macro (calls, conditions, "
-                        "TI). Move part of it into a macro of its own",
+        "loop": "this loop holds {count} commands as written, and the compiler adds {added} to "
+                "repeat them: {total}, and a macro holds at most {max} (MS176E §3.8). A loop "
+                "line cannot be split (its RP repeats the whole line), and calls, conditions "
+                "and TI cannot move out of it. Write at most {room} commands in the loop, or "
+                "move some into a macro of your own and `call` it",
     }),
     Rule("MM006", "slot-range", _E, "macro number outside 0-31, or more than 32 macros", """\
 Macros are numbered 0 to 31 (MS176E §3.8.4); macro 0 is the autostart macro.
@@ -291,6 +293,13 @@ Move the TI out of the when block, straight into the loop.""", {"": "this TI run
 `repeat 0 { ... }` runs its block no times, so mercmac leaves it out (RP
 cannot express it: a line always runs at least once, MS176E §6.4 RP). Remove
 the block, or give a count of 1 or more.""", {"": "repeat 0 never runs its block: it is left out"}),
+    Rule("MM033", "every-zero", _W, "every 0ms: a polling loop without a wait", """`every 0ms { ... }` waits nothing between passes, so it is a busy loop: it runs
+at the full command rate, one command per controller cycle (SPEC §3), keeps the
+controller busy and floods the host with any reports the block makes. The
+simulator reports it as a busy-loop hazard. Give the loop a period of a few ms
+(`every 20ms`), which adds a WA to each pass.""", {
+        "": "every 0ms waits nothing between passes: a busy loop at the full command rate; "
+            "poll every few ms instead (every 20ms)"}),
 )
 
 _BY_KEY = {r.code: r for r in RULES} | {r.name: r for r in RULES}

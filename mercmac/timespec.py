@@ -43,6 +43,14 @@ def parse_duration(text: str) -> int:
     return int(value)
 
 
+def format_duration(ms: int) -> str:
+    """A duration with its unit, in the largest unit it is whole in: '3 ms', '10 s', '1500 d'."""
+    for unit, size in reversed(UNIT_MS.items()):
+        if ms and ms % size == 0:
+            return f"{ms // size:,} {unit}"
+    return f"{ms:,} ms"
+
+
 def _too_large(text: str) -> TimeSpecError:
     days = MAX_MS // UNIT_MS["d"]
     return TimeSpecError(f"{_quote(text)} is too large: durations are at most {days}d (100 years)")

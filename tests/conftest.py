@@ -75,3 +75,10 @@ def program_file(tmp_path, request):
 @pytest.fixture
 def examples_dir() -> Path:
     return EXAMPLES
+
+
+@pytest.fixture(autouse=True)
+def _private_data_dir(tmp_path_factory, monkeypatch):
+    """Backups and flash history go to a fresh folder, never the user's data directory."""
+    monkeypatch.delenv("MERCMAC_DATA_DIR", raising=False)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path_factory.mktemp("xdg-data")))

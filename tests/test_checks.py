@@ -23,6 +23,9 @@ FINDS = [
     ("goto-ends-loop", "macro x { TP }\nautostart { repeat 3 { CN 1, TT, goto x }, CN 2 }\n", None),
     ("ti-moved", "autostart { repeat 3 { when 1 { TI } } }\n", None),
     ("repeat-zero", "macro a { repeat 0 { TP } }\n", None),
+    # issue 13: every 0ms is a busy loop, flagged like a macro that calls itself in the sim
+    ("every-zero", "autostart { every 0ms { when 1 { CN 1 } } }\n", None),
+    ("every-zero", "const P = 0\nautostart { every P { TP } }\n", None),
     ("syntax", "[MC01] MR 5.5\n", None),
     ("unknown-command", "[MC01] XY5\n", None),
     ("unknown-command", "macro a { FOO 3 }\n", None),

@@ -56,9 +56,16 @@ def test_check_target_option_overrides_file(tmp_path):
 
 def test_build_prints_md_lines_macro_0_last():
     r = cli("build", EX4)
-    lines = r.output.splitlines()
+    lines = r.stdout.splitlines()
     assert r.exit_code == 0 and lines[-1] == "MD0,EM9,EM10" and lines[0].startswith("MD9,BF,DP200")
     assert len(lines) == 23
+
+
+def test_build_shows_warnings_on_stderr_and_goes_on():
+    """Example 4 has three nested-call warnings: shown, and the MD lines still printed."""
+    r = cli("build", EX4)
+    assert r.exit_code == 0 and r.stderr.count("warning[MM011 nested-call]") == 3
+    assert "warning" not in r.stdout and r.stdout.startswith("MD9,")
 
 
 def test_build_writes_output_file(tmp_path):

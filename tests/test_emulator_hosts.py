@@ -256,7 +256,7 @@ def test_emulate_logs_every_byte_both_ways_with_times(tmp_path):
             assert ask(port, SELECT + b"TB\r") == [b"B:0" + END]
     finally:
         proc.send_signal(signal.SIGINT)
-        assert proc.wait(timeout=5) == 0
+        assert proc.wait(timeout=5) == 130  # Ctrl-C, as `scan` and `sim --interactive`
     lines = log.read_text().splitlines()
     assert lines[0].startswith("# ")
     bytes_lines = [line for line in lines if not line.startswith("#")]

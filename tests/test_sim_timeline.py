@@ -20,8 +20,9 @@ POLLS = ("steps.when@49", "steps.when@50", "steps.when@51", "steps.when@52",
 def sim(*args: str) -> list[str]:
     result = CliRunner().invoke(main, ["sim", *args])
     assert result.exit_code == 0, result.output
-    timeline = result.output.split("\n\nSummary")[0]
-    return timeline.splitlines()
+    header, *timeline = result.output.split("\n\nSummary")[0].splitlines()
+    assert header.startswith("Simulating a C-863 from power-on until ")
+    return timeline
 
 
 def seconds(line: str) -> float:

@@ -170,7 +170,7 @@ def test_emulate_serves_a_pty_and_keeps_its_state(tmp_path, program_file):
                 assert "[MC00] EM5" in result.output and "[MC05] MR5000,WS100" in result.output
         finally:
             proc.send_signal(signal.SIGINT)
-            assert proc.wait(timeout=5) == 0
+            assert proc.wait(timeout=5) == 130  # Ctrl-C, as `scan` and `sim --interactive`
 
 
 @pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs pseudo-terminals")

@@ -24,6 +24,9 @@ class _Commands(click.Group):
         "scan": ("mercmac.cli.upload", "scan"),
         "emulate": ("mercmac.cli.upload", "emulate"),
         "lsp": ("mercmac.cli.lsp", "lsp"),
+        "decompile": ("mercmac.cli.inspect", "decompile"),
+        "describe": ("mercmac.cli.inspect", "describe"),
+        "history": ("mercmac.cli.inspect", "history"),
     }
 
     def list_commands(self, ctx: click.Context) -> list[str]:
@@ -194,7 +197,8 @@ def _check_one(source, target: str | None):
 def build(file: str, output: str | None, target: str | None) -> None:
     """Print the MD lines that go to the controller: slot order, macro 0 last.
 
-    Refuses (exit 1, diagnostics on standard error) when the file has errors.
+    Refuses (exit 1, diagnostics on standard error) when the file has errors;
+    warnings are shown on standard error and the build goes on.
     """
     def work() -> int:
         from mercmac.compiler import compile_file
@@ -203,6 +207,7 @@ def build(file: str, output: str | None, target: str | None) -> None:
         result = compile_file(file, target=target)
         if render.write_errors(result):
             return EXIT_FAILED
+        render.write_warnings(result)  # on standard error: the MD lines stay clean
         text = "".join(line + "\n" for line in result.program.md_lines())
         if output and output != "-":
             from mercmac import outfile

@@ -16,9 +16,10 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
 @click.argument("file", type=click.Path(dir_okay=False, allow_dash=True))
 @click.option("--buttons", default="", metavar="SPEC",
               help='Button script: "1@0-2s,2+3@5s-5.2s" (input B held from T1 to T2, or from T1 on). '
-                   "Overlapping presses of one button merge into one.")
+                   "Times without a unit are milliseconds. Overlapping presses of one button merge into one.")
 @click.option("--until", "until", default=None, metavar="DURATION",
-              help="How long to simulate: 500ms, 10s, 2h, 1500d.  [default: 10s]")
+              help="How long to simulate: 500ms, 10s, 2h, 1500d; a number without a unit is "
+                   "milliseconds (--until 3 is 3 ms).  [default: 10s]")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="A timeline for people or JSON for programs.")
 @click.option("-v", "--verbose", count=True,

@@ -10,14 +10,32 @@ import sys
 import click
 
 from mercmac.cli.common import MODEL_CHOICE, FiniteFloat, run_guarded
-from mercmac.errors import EXIT_FAILED, EXIT_OK, UsageError
+from mercmac.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, UsageError
 
 _ADDRESS = click.option("--address", type=click.IntRange(0, 15), default=0, show_default=True,
                         help="Controller address, DIP switches 1-4 (MS176E §3.1.3).")
+# flash and pull: no --address looks for the controller (survey.find_address)
+_FIND_ADDRESS = click.option("--address", type=click.IntRange(0, 15), default=None,
+                             help="Controller address, DIP switches 1-4 (MS176E §3.1.3). "
+                                  "Default: 0 if a controller answers there, else the only "
+                                  "address that answers (1-15 searched, about 5 s).")
+_PORT_OPTION = click.option("-p", "--port", "port_option", metavar="PORT",
+                            help="The port, as PORT; default: $MERCMAC_PORT, else the only PI USB "
+                                 "device (vendor 0x1A72), else the only serial port.")
 _BAUD = click.option("--baud", type=click.IntRange(300, 921_600), default=9600, show_default=True,
                      help="Baud rate, DIP switches 5-6.")
 _TIMEOUT = click.option("--timeout", type=FiniteFloat(0.05, 60), default=1.0,
                         show_default=True, help="Seconds to wait for each reply.")
+
+
+def _port(port: str | None, option: str | None, command: str) -> str:
+    """The port to open (mercmac.upload.ports); says on stderr how it was found if not given."""
+    from mercmac.upload import ports as chooser
+
+    chosen = chooser.resolve(chooser.check_port_arg(port, option, command))
+    if chosen.how:
+        click.echo(f"port: {chosen.port} ({chosen.how})", err=True)
+    return chosen.port
 
 
 def _timing(timeout: float):
@@ -27,9 +45,11 @@ def _timing(timeout: float):
 
 
 @click.command()
-@click.argument("port")
-@click.argument("file", type=click.Path(dir_okay=False, allow_dash=True))
-@_ADDRESS
+@click.argument("port", required=False, metavar="[PORT]")
+@click.argument("file", required=False, metavar="FILE",
+                type=click.Path(dir_okay=False, allow_dash=True))
+@_PORT_OPTION
+@_FIND_ADDRESS
 @_BAUD
 @click.option("--dry-run", is_flag=True, help="Read back and show the exact bytes; write nothing.")
 @click.option("--backup", type=click.Path(dir_okay=False, writable=True),
@@ -40,30 +60,36 @@ def _timing(timeout: float):
 @click.option("--force", is_flag=True, help="Flash even if the controller is not the file's target.")
 @click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
 @_TIMEOUT
-def flash(port, file, address, baud, dry_run, backup, erase_unused, reset, force, target,
-          timeout) -> None:
+def flash(port, file, port_option, address, baud, dry_run, backup, erase_unused, reset, force,
+          target, timeout) -> None:
     """Upload FILE to the controller on PORT: back up, write what differs, verify.
 
     PORT is anything pyserial opens: COM3, /dev/ttyUSB0, a pty path,
-    socket://host:port. Exit 0 only when every written macro reads back right.
+    socket://host:port. Without it: -p PORT, $MERCMAC_PORT, or the only likely
+    Mercury port. Exit 0 only when every written macro reads back right.
     """
     def work() -> int:
+        nonlocal port, file
         from pathlib import Path
 
         from mercmac.render import upload as view
         from mercmac.render.console import write_lines
         from mercmac.upload import backup as backups
         from mercmac.upload import flasher
+        from mercmac.upload import ports as chooser
 
+        given, file = chooser.split_flash_args(port, file, port_option)  # also `flash FILE PORT`
+        port = _port(given, port_option, "flash")
         options = flasher.FlashOptions(erase_unused, dry_run, reset, Path(backup) if backup else None)
         try:
             result = flasher.flash_file(port, file, address=address, baud=baud,
                                         timing=_timing(timeout), options=options, target=target,
                                         force=force, watch=_watch(port, address, finished))
+            address_used = result.identity.address
         except backups.BackupError as e:
             raise _unwritable(e) from None
         if dry_run:
-            write_lines(view.dry_run_lines(result, address, baud))
+            write_lines(view.dry_run_lines(result, address_used, baud))
         write_lines(view.flash_summary(result, port))
         return EXIT_OK
 
@@ -85,7 +111,7 @@ def _reporting_completion(work, finished) -> int:
             from None
 
 
-def _watch(port: str, address: int, finished: list):
+def _watch(port: str, address: int | None, finished: list):
     """What `flash` shows while flashing: diagnostics, who answered, a progress bar."""
     from contextlib import contextmanager
 
@@ -94,12 +120,27 @@ def _watch(port: str, address: int, finished: list):
     from mercmac.render.console import write_lines
     from mercmac.upload import flasher
 
+    searched = [False]  # no --address, nothing at 0: addresses 1-15 were searched
+
     class Shown(flasher.Watch):
         def refused(self, compilation) -> None:
             render.write_errors(compilation)  # on standard error, before the refusal
 
+        def compiled(self, compilation) -> None:
+            render.write_warnings(compilation)  # on standard error; the flash goes on
+
+        @contextmanager
+        def searching(self):
+            with view.AddressProgress(sys.stderr, "no --address: looking for the controller") \
+                    as shown:
+                def probing(n: int) -> None:
+                    searched[0] = True
+                    shown(n)
+                yield probing
+
         def identified(self, identity, warning) -> None:
-            write_lines(view.identity_lines(port, address, identity, warning))
+            write_lines(view.identity_lines(port, identity.address, identity, warning,
+                                            searched=searched[0]))
 
         @contextmanager
         def writing(self):
@@ -113,40 +154,61 @@ def _watch(port: str, address: int, finished: list):
 
 
 @click.command()
-@click.argument("port")
+@click.argument("port", required=False, metavar="[PORT]")
+@_PORT_OPTION
 @click.option("-o", "--output", type=click.Path(dir_okay=False, allow_dash=True),
               help="Write the .mcm file here instead of standard output.")
-@_ADDRESS
+@_FIND_ADDRESS
 @_BAUD
 @_TIMEOUT
-def pull(port, output, address, baud, timeout) -> None:
+@click.option("--raw", is_flag=True, help="The stored macros as [MCnn] lines, even when they "
+                                          "match a flash in `mercmac history`.")
+def pull(port, port_option, output, address, baud, timeout, raw) -> None:
     """Read every macro of the controller on PORT into a .mcm file.
 
     The file passes `mercmac check`, and `mercmac flash` puts back exactly
-    these macros. Reading stops a running macro (MS176E §3.8.3).
+    these macros. When they are exactly a program `mercmac flash` wrote, that
+    source comes back, names and comments included (--raw: the macros as stored).
+    Reading stops a running macro (MS176E §3.8.3).
     """
     def work() -> int:
+        nonlocal port, address
         from pathlib import Path
 
         from mercmac.render import upload as view
         from mercmac.render.console import write_lines
         from mercmac.upload import backup, connect, survey
 
+        port = _port(port, port_option, "pull")
         to_file = output and output != "-"
         if to_file:
             _check_output(Path(output))  # refused before reading, which stops a running macro
-        with connect.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
+        with connect.open_controller(port, address or 0, baud=baud, timing=_timing(timeout)) as c:
+            if address is None:  # 0 if anything answers there, else the only one that does
+                with view.AddressProgress(sys.stderr, "no --address: looking for the controller") \
+                        as shown:
+                    c.address = survey.find_address(c.transport, shown)
             pulled = survey.pull(c)
+        address = pulled.identity.address
+        text, found = pulled.text, None
+        if not raw:  # a program mercmac flashed comes back as its source (upload.history)
+            from mercmac.upload import history
+
+            found = history.lookup(pulled.macros, port=port, address=address)
+            text = found.source if found else text
         if to_file:
             try:
-                backup.save(pulled.text, Path(output))
+                backup.save(text, Path(output))
             except backup.BackupError as e:
                 raise UsageError(str(e)) from None
         else:
-            click.echo(pulled.text, nl=False)
+            click.echo(text, nl=False)
         err = sys.stderr
         write_lines(view.identity_lines(port, address, pulled.identity), err)
         write_lines(view.pulled_lines(pulled, port, address, output if to_file else None), err)
+        if found:
+            click.echo(f"the controller holds {found.label}: that source is given back "
+                       f"(--raw for the stored macros)", err=True)
         return EXIT_OK
 
     run_guarded(work)
@@ -182,24 +244,29 @@ def ports() -> None:
 
 
 @click.command()
-@click.argument("port")
+@click.argument("port", required=False, metavar="[PORT]")
+@_PORT_OPTION
 @_BAUD
 @click.option("--timeout", type=FiniteFloat(0.05, 60), default=0.3, show_default=True,
               help="Seconds to wait at each address.")
 @click.option("--stop", is_flag=True, help="Also identify controllers that run a macro (stops it).")
-def scan(port, baud, timeout, stop) -> None:
+def scan(port, port_option, baud, timeout, stop) -> None:
     """Which addresses 0-15 answer on PORT, with model and firmware (daisy chains, MS176E §3.2).
 
     Probes with `%`, which does not stop a running macro; such controllers
     are listed without firmware unless --stop is given. Exit 1 if none answers.
+    On a terminal, the address being probed is shown as the scan goes.
     """
     def work() -> int:
+        nonlocal port
         from mercmac.render import upload as view
         from mercmac.render.console import write_lines
         from mercmac.upload import connect, survey
 
-        with connect.open_controller(port, 0, baud=baud, timing=_timing(timeout)) as c:
-            found = survey.scan(c.transport, stop=stop)
+        port = _port(port, port_option, "scan")
+        with connect.open_controller(port, 0, baud=baud, timing=_timing(timeout)) as c, \
+                view.AddressProgress(sys.stderr) as shown:
+            found = survey.scan(c.transport, stop=stop, on_address=shown)
         write_lines(view.scan_lines(found, port))
         return EXIT_OK if survey.answered(found) else EXIT_FAILED
 
@@ -215,7 +282,7 @@ def scan(port, baud, timeout, stop) -> None:
 @click.option("--firmware", default="2.30", show_default=True,
               help="Firmware version VE reports; 1.xx drops lines typed slower than 20 ms a character.")
 @click.option("--tm-framing", type=click.Choice(["etx-per-line", "one-etx"]), default="etx-per-line",
-              show_default=True, help="How a TM listing ends its lines (SPEC §4 allows both).")
+              show_default=True, help="How a TM listing ends its lines (real controllers may do either).")
 @click.option("--empty-slot", type=click.Choice(["empty", "bare"]), default="empty",
               show_default=True, help="TMn of an empty slot: an empty report or a bare MCnnn.")
 @click.option("--log", "log_file", type=click.Path(dir_okay=False),
@@ -229,7 +296,7 @@ def emulate(target, address, state, firmware, tm_framing, empty_slot, log_file, 
             baud) -> None:
     """Serve a virtual controller on a pseudo-terminal and print the path to open.
 
-    Try `mercmac flash PATH FILE` without hardware; Ctrl-C stops it.
+    Try `mercmac flash PATH FILE` without hardware; Ctrl-C stops it (exit 130).
     """
     def work() -> int:
         from contextlib import nullcontext
@@ -256,8 +323,8 @@ def emulate(target, address, state, firmware, tm_framing, empty_slot, log_file, 
             click.echo(server.path)
             try:
                 server.serve_forever()
-            except KeyboardInterrupt:
-                pass
+            except KeyboardInterrupt:  # the only way it ends: 130, as `scan` and `sim -i` exit
+                return EXIT_INTERRUPTED
             finally:
                 server.close()
         return EXIT_OK

@@ -76,5 +76,13 @@ def _check_partial(source: Source, module, broken: frozenset[int], report: Repor
 
 
 def compile_file(path: str, target: str | None = None) -> Compilation:
-    """Read and compile a file; OSError propagates for the CLI to report (exit 2)."""
-    return compile_source(read_source(path), target)
+    """Read and compile a file; an unreadable one is a UsageError (exit 2), worded as
+    `check` words it: "cannot read FILE: reason"."""
+    from mercmac.errors import UsageError
+    from mercmac.outfile import reason
+
+    try:
+        source = read_source(path)
+    except OSError as e:
+        raise UsageError(f"cannot read {path}: {reason(e)}") from None
+    return compile_source(source, target)

@@ -112,6 +112,8 @@ def _block(body: tuple, env: Env, report: Report) -> None:
         elif isinstance(stmt, ast.Every):
             _bounded(stmt.period, env, report, range(0, MAX_PERIOD_MS + 1), "every",
                      max=MAX_PERIOD_MS, wa=MAX_WA)
+            if _resolve(stmt.period, env, Report(report.file)) == 0:  # already range-checked
+                report.add("every-zero", stmt.span)
             _loop_goto(stmt, "every", report)
             _block(stmt.body, env, report)
 

@@ -82,6 +82,7 @@ class _Lowerer:
         self.loops: list[_Macro] = []  # the macro of each loop being lowered (for TI)
         self.warned: set = set()
         self.inlined: set[str] = set()
+        self.added: set[int] = set()  # id() of the RPs and WAs a loop adds: the user did not write them
 
     def new(self, name: str, origin: Origin, span: Span, slot: int | None = None) -> _Macro:
         m = _Macro(name, origin, span, slot)
@@ -184,12 +185,19 @@ class _Lowerer:
         self.loops.pop()
         if isinstance(stmt, ast.Repeat):
             # RP n runs the line n+1 times; two RPs multiply (program.rp_counts)
-            return body + [Op(Mnemonic.RP, n, stmt.span) for n in rp_counts(self.count(stmt))]
+            return body + self.add([Op(Mnemonic.RP, n, stmt.span)
+                                    for n in rp_counts(self.count(stmt))])
         # every T: wait T (several WAs past 65535 ms), then RP,RP = 65536 x 65536
         # passes, "forever" (§3.8.6 Example 1)
-        waits = [Op(Mnemonic.WA, ms, stmt.span)
-                 for ms in wait_pieces(self.value(stmt.period) or 0)]
-        return body + waits + [Op(Mnemonic.RP, None, stmt.span), Op(Mnemonic.RP, None, stmt.span)]
+        period = self.value(stmt.period) or 0  # every 0ms: no WA0, a busy loop (every-zero)
+        waits = [Op(Mnemonic.WA, ms, stmt.span) for ms in wait_pieces(period)] if period else []
+        return body + self.add(waits + [Op(Mnemonic.RP, None, stmt.span),
+                                        Op(Mnemonic.RP, None, stmt.span)])
+
+    def add(self, ops: list) -> list:
+        """Ops the compiler adds to a loop (RP, WA): a too-long loop counts them apart."""
+        self.added.update(id(op) for op in ops)
+        return ops
 
     def conditions(self, stmt: ast.When) -> list:
         return [Op(Mnemonic.XF if c.negated else Mnemonic.XN, self.value(c.value), c.span)
@@ -261,14 +269,23 @@ class _Lowerer:
                 return
             runs = _movable_runs(m.ops[:last])
             if not runs:
-                self.report.add("too-many-commands", m.span, "unsplittable", macro=f"'{m.name}'",
-                                count=len(m.ops), max=MAX_COMMANDS)
+                self.too_long_loop(m)
                 return
             start, end = max(runs, key=lambda r: r[1] - r[0])
             end = start + min(end - start, len(m.ops) - MAX_COMMANDS + 1, MAX_COMMANDS)
             part = self.new(self.part_name(m), Origin.PART, m.span)
             part.ops = m.ops[start:end]
             m.ops[start:end] = [_Em(part, _span_of(part.ops[0], m.span), Role.HOIST)]
+
+    def too_long_loop(self, m: _Macro) -> None:
+        """A loop line that cannot be split, said in the user's terms: the commands they
+        wrote, and the RP (WA) the loop adds, which they did not."""
+        added = [op for op in m.ops if id(op) in self.added or
+                 (isinstance(op, _Em) and op.role in (Role.HOIST, Role.CONTINUE))]
+        loop = next((op.span for op in added if isinstance(op, Op)), m.span)
+        self.report.add("too-many-commands", loop, "loop", count=len(m.ops) - len(added),
+                        added=_added_words(added), total=len(m.ops), max=MAX_COMMANDS,
+                        room=max(0, MAX_COMMANDS - len(added)))
 
     def part_name(self, m: _Macro) -> str:
         """'jog.part2', 'jog.part3', ...: the next free part name of a split macro."""
@@ -303,6 +320,16 @@ class _Lowerer:
                     continue
                 taken[m.slot] = m
         return taken
+
+
+def _added_words(added: list) -> str:
+    """What a loop added, for a message: '1 RP', '1 WA and 2 RPs', '1 RP and 2 EMs'."""
+    rps = sum(isinstance(op, Op) and op.mnemonic == Mnemonic.RP for op in added)
+    was = sum(isinstance(op, Op) and op.mnemonic == Mnemonic.WA for op in added)
+    ems = len(added) - rps - was  # tail and hoisting EMs
+    parts = [f"{n} {what}{'s' * (n != 1)}" for n, what in
+             ((rps, Mnemonic.RP), (was, Mnemonic.WA), (ems, Mnemonic.EM)) if n]
+    return " and ".join(parts) or "nothing"
 
 
 def _is_op(op, mnemonic: str) -> bool:

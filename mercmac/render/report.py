@@ -151,6 +151,17 @@ def write_errors(result, stream: IO[str] | None = None) -> bool:
     return True
 
 
+def write_warnings(result, stream: IO[str] | None = None) -> None:
+    """Show a compilation's warnings on stderr (infos stay with `check`); `build` and
+    `flash` go on: a warning is worth reading, not a reason to refuse."""
+    from mercmac.diagnostics import Severity
+
+    warnings = [d for d in result.report.items if d.severity is Severity.WARNING]
+    if warnings:
+        write_text(warnings, {result.source.name: result.source}, 1, stream or sys.stderr,
+                   summary=False)  # "0 infos" would be untrue: infos are left out
+
+
 def to_json(diagnostics: Iterable[Diagnostic], limit: int = MAX_JSON) -> str:
     """The `check --format json` object (SPEC §5); with more than `limit` diagnostics in a
     file (0: no limit), the first `limit` and `"truncated": {file: count left out}`."""

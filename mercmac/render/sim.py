@@ -254,7 +254,15 @@ def write_text(run: Run, stream: IO[str] | None = None, *, with_trace: bool = Fa
                verbose: int = 0) -> None:
     """The timeline at a verbosity (or the trace) and the summary, for people."""
     body = trace(run.record) if with_trace else timeline(run.record, verbose) + [ending(run)]
-    write_lines([line for line in body if line] + summary(run), stream)
+    write_lines([header(run)] + [line for line in body if line] + summary(run), stream)
+
+
+def header(run: Run) -> Line:
+    """What was simulated, and for how long, with the unit: `--until 3` is 3 ms, not 3 s."""
+    from mercmac.timespec import format_duration
+
+    return [(f"Simulating a {run.machine.model} from power-on until {format_duration(run.until_ms)}",
+             "bold")]
 
 
 def write_vcd_cut(path: str, limit_mb: float, cut_at: int, stream: IO[str] | None = None) -> None:

@@ -5,6 +5,7 @@ and colour on a terminal (render/console.py decides, NO_COLOR honoured).
 """
 from __future__ import annotations
 
+import os
 import sys
 from typing import IO
 
@@ -12,13 +13,24 @@ from mercmac.render.console import Line, rich_console, use_colour, write_lines
 
 _FATE_STYLE = {"written": "bold green", "erased": "bold yellow", "re-written last": "green",
                "unchanged": "dim", "kept (not in file)": "yellow"}
+# a dry run writes nothing: its table says what a flash would do to each slot
+_WOULD = {"written": "would be written", "erased": "would be erased",
+          "re-written last": "would be removed first, written back last",
+          "unchanged": "unchanged", "kept (not in file)": "kept (not in file)"}
+_WOULD_TALLY = {"written": "write {n}", "erased": "erase {n}", "re-written last": "write back {n} last",
+                "unchanged": "leave {n} unchanged", "kept (not in file)": "keep {n} not in the file"}
 
 
-def identity_lines(port: str, address: int, identity, warning: str | None = None) -> list[Line]:
-    """'C-863, firmware 2.30, at address 0 on /dev/ttyUSB0' and what we had to do."""
+def identity_lines(port: str, address: int, identity, warning: str | None = None, *,
+                   searched: bool = False) -> list[Line]:
+    """'C-863, firmware 2.30, at address 0 on /dev/ttyUSB0' and what we had to do;
+    `searched`: no --address was given and the address was found by a search."""
     v = identity.version
     lines: list[Line] = [[("controller: ", "bold"), (f"{v.name}, firmware {v.firmware}", "cyan"),
                           (f", at address {address} on {port}", "")]]
+    if searched:
+        lines.append([("note: ", "bold"), (f"no --address given and nothing at 0: address {address} "
+                                           f"is the only one that answers", "")])
     if identity.stopped_macro:
         lines.append([("note: ", "bold yellow"), ("a macro was running; it was stopped", "")])
     if warning:
@@ -32,15 +44,19 @@ class FlashProgress:
     def __init__(self, stream: IO[str] | None = None):
         self.stream = stream or sys.stdout
         self._progress = self._task = None
+        self._started: tuple[float, int] | None = None  # (time, bytes sent) at the first step
 
     def __enter__(self) -> "FlashProgress":
         if use_colour(self.stream):
-            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+            from rich.progress import BarColumn, Progress, TextColumn
 
             # no refresh thread: it would keep redrawing the bar over the message of a
-            # Ctrl-C that cut `stop` short; the bar is redrawn on each event instead
+            # Ctrl-C that cut `stop` short; the bar is redrawn on each event instead.
+            # The bar counts bytes (commands and read-backs): a rate and the time left follow.
             self._progress = Progress(TextColumn("[bold]{task.description:<28}"), BarColumn(),
-                                      MofNCompleteColumn(), console=rich_console(self.stream),
+                                      TextColumn("{task.fields[steps]}"),
+                                      TextColumn("[dim]{task.fields[rate]}"),
+                                      console=rich_console(self.stream),
                                       transient=True, auto_refresh=False)
             self._progress.start()
         return self
@@ -49,20 +65,65 @@ class FlashProgress:
         if self._progress:
             self._progress.stop()
 
+    def _rate(self, event) -> str:
+        """Bytes per second since the first step, and the time left at that rate."""
+        import time
+
+        now = time.monotonic()
+        if self._started is None:
+            self._started = (now, event.sent)
+        start, sent0 = self._started
+        return _rate_text(event.sent - sent0, event.size - sent0, now - start)
+
     def __call__(self, event) -> None:
         if self._progress is None:
             if event.kind != "step":
                 write_lines([_event_line(event)], self.stream)
             return
         if event.kind in ("step", "verified"):
+            steps, rate = f"{event.done}/{event.total}", self._rate(event)
             if self._task is None:
-                self._task = self._progress.add_task(event.text, total=event.total)
-            self._progress.update(self._task, description=event.text, completed=event.done,
-                                  refresh=True)
+                self._task = self._progress.add_task(event.text, total=event.size or event.total,
+                                                     steps=steps, rate=rate)
+            self._progress.update(self._task, description=event.text, steps=steps, rate=rate,
+                                  completed=event.sent if event.size else event.done, refresh=True)
         else:
             from rich.text import Text
 
             self._progress.console.print(Text.assemble(*_event_line(event)))
+
+
+class AddressProgress:
+    """'scanning: address 5 of 0-15' redrawn in place on a terminal; nothing elsewhere (logs)."""
+
+    def __init__(self, stream: IO[str] | None = None, what: str = "scanning"):
+        self.stream, self.what, self.shown = stream or sys.stderr, what, False
+        isatty = getattr(self.stream, "isatty", None)
+        self.live = bool(isatty and isatty()) or bool(os.environ.get("FORCE_COLOR"))
+
+    def __enter__(self) -> "AddressProgress":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.shown:
+            self.stream.write("\r\x1b[K")  # the line goes away before the result is printed
+            self.stream.flush()
+
+    def __call__(self, address: int) -> None:
+        if self.live:
+            # \r and ESC [K (erase to end of line): the line is redrawn where it stands
+            self.stream.write(f"\r\x1b[K{self.what}: address {address} of 0-15 ...")
+            self.stream.flush()
+            self.shown = True
+
+
+def _rate_text(sent: int, size: int, seconds: float) -> str:
+    """'38 B/s, 0:00:12 left' once some bytes went out; '' before."""
+    if sent <= 0 or seconds <= 0:
+        return ""
+    rate = sent / seconds
+    left = int(round((size - sent) / rate)) if size > sent else 0
+    return f"{rate:,.0f} B/s, {left // 3600}:{left % 3600 // 60:02d}:{left % 60:02d} left"
 
 
 def _event_line(event) -> Line:
@@ -75,17 +136,21 @@ def _event_line(event) -> Line:
 def flash_summary(result, port: str) -> list[Line]:
     """The slot table and the outcome line."""
     plan = result.plan
-    rows = [(f"MC{slot:02d}", _name(plan.names.get(slot), slot), fate.value)
-            for slot, fate in sorted(plan.fates.items())]
-    lines = table(("slot", "macro", "result"), rows, style_of=lambda row: _FATE_STYLE.get(row[2], ""))
-    if result.dry_run:
-        lines.append([("dry run: ", "bold yellow"), (f"nothing written ({_tally(plan)})", "")])
-        return lines
+    dry = result.dry_run
+    rows = [(f"MC{slot:02d}", _name(plan.names.get(slot), slot),
+             _WOULD[fate.value] if dry else fate.value) for slot, fate in sorted(plan.fates.items())]
+    styles = {(_WOULD[k] if dry else k): v for k, v in _FATE_STYLE.items()}
+    lines = table(("slot", "macro", "a flash" if dry else "result"), rows,
+                  style_of=lambda row: styles.get(row[2], ""))
+    if dry:
+        lines.append([("dry run: ", "bold yellow"), (f"nothing written; {_would(plan)}", "")])
+        return lines + _restore_note(result)
     lines.append([("ok: ", "bold green"), (_outcome(plan), "")])
     if result.retried or result.repaired:
         again = ", ".join(f"MC{s:02d}" for s in result.retried + result.repaired)
         lines.append([("note: ", "bold yellow"), (f"needed a second write: {again} (check the cable)", "")])
     lines.append([("backup: ", "bold"), (str(result.backup), "")])
+    lines += _restore_note(result)
     if result.reset:
         lines.append([("reset: ", "bold"), ("RT sent, macro 0 is starting", "")])
     elif 0 in plan.after and not plan.changes_nothing:
@@ -93,10 +158,23 @@ def flash_summary(result, port: str) -> list[Line]:
     return lines
 
 
+def _restore_note(result) -> list[Line]:
+    """A backup flashed back without --erase-unused leaves the macros it lacks: say so."""
+    extra = result.left_over if result.restoring else []
+    if not extra:
+        return []
+    held = len(result.plan.after) - len(extra)
+    slots = ", ".join(f"MC{s:02d}" for s in extra)
+    return [[("note: ", "bold yellow"),
+             (f"this backup holds {held} macro{'s' if held != 1 else ''}; the controller also "
+              f"holds {slots}, which {'were' if not result.dry_run else 'would be'} kept: to "
+              f"restore the backup exactly, flash it again with --erase-unused", "")]]
+
+
 def completed_text(result) -> str:
     """The outcome of a finished flash in plain words, for a Ctrl-C while it is being shown."""
     if result.dry_run:
-        return f"dry run complete, nothing was written ({_tally(result.plan)})"
+        return f"dry run complete, nothing was written; {_would(result.plan)}"
     reset = "; RT was sent, macro 0 is starting" if result.reset else ""
     return f"the flash had finished: {_outcome(result.plan)}{reset}\n  backup: {result.backup}"
 
@@ -115,7 +193,17 @@ def _tally(plan) -> str:
     return ", ".join(f"{n} {what}" for what, n in counts.items()) or "no macros"
 
 
-def dry_run_lines(result, address: int, baud: int) -> list[Line]:
+def _would(plan) -> str:
+    """'a flash would write 2, leave 1 unchanged': the plan in the conditional."""
+    if plan.changes_nothing:
+        return "a flash would write nothing: the controller already holds this program"
+    counts: dict[str, int] = {}
+    for fate in plan.fates.values():
+        counts[fate.value] = counts.get(fate.value, 0) + 1
+    return "a flash would " + ", ".join(_WOULD_TALLY[what].format(n=n) for what, n in counts.items())
+
+
+def dry_run_lines(result, address: int | None, baud: int) -> list[Line]:
     """Every byte a real flash would now send, and what for."""
     from mercmac.upload.protocol import show
 

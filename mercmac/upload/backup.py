@@ -14,6 +14,9 @@ from mercmac import __version__, outfile
 from mercmac.upload.protocol import Version
 
 
+DATA_DIR_VARIABLE = "MERCMAC_DATA_DIR"
+
+
 class BackupError(Exception):
     """The backup file cannot be written; nothing may be flashed then."""
 
@@ -38,16 +41,25 @@ def to_mcm(macros: dict[int, str], version: Version, *, port: str, address: int,
 
 def default_path(port: str, address: int, when: _dt.datetime | None = None) -> Path:
     """A timestamped file in the per-user data directory: never overwrites an older backup."""
-    import platformdirs
-
     when = when or _dt.datetime.now()
-    folder = Path(platformdirs.user_data_dir("mercmac", appauthor=False)) / "backups"
+    folder = data_dir() / "backups"
     stem = f"{_port_tag(port)}-addr{address}-{when.strftime('%Y%m%d-%H%M%S')}"
     path, n = folder / f"{stem}.mcm", 1
     while path.exists():
         n += 1
         path = folder / f"{stem}-{n}.mcm"
     return path
+
+
+def data_dir() -> Path:
+    """mercmac's per-user data directory (backups, flash history); $MERCMAC_DATA_DIR overrides it."""
+    import os
+
+    if chosen := os.environ.get(DATA_DIR_VARIABLE):
+        return Path(chosen)
+    import platformdirs
+
+    return Path(platformdirs.user_data_dir("mercmac", appauthor=False))
 
 
 def check(path: Path) -> Path:

@@ -22,6 +22,7 @@ class Identity:
 
     version: Version
     stopped_macro: bool
+    address: int = 0  # where it answered: --address, or the only one a search found
 
 
 @contextmanager
@@ -49,7 +50,7 @@ def identify(controller: Controller) -> Identity:
                           hint="stop it with any key in a terminal, or power-cycle it")
     except ControllerError as e:
         raise refusal(controller, e) from None
-    return Identity(version, running)
+    return Identity(version, running, controller.address)
 
 
 def refusal(controller: Controller, e: ControllerError) -> Refused:

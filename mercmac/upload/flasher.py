@@ -33,6 +33,8 @@ class Event:
     text: str
     done: int = 0
     total: int = 0
+    sent: int = 0  # bytes of the plan's steps sent so far (commands and read-backs)
+    size: int = 0  # bytes of all the plan's steps: with `sent`, a rate and the time left
 
 
 Notify = Callable[[Event], None]
@@ -59,9 +61,20 @@ class FlashResult:
     reset: bool = False
     retried: list[int] = field(default_factory=list)
     repaired: list[int] = field(default_factory=list)
+    recorded: Path | None = None  # the history record of this flash (mercmac.upload.history)
 
-    def wire(self, address: int) -> list[tuple[bytes, str]]:
+    restoring: bool = False  # the file is a backup (pull or flash wrote it)
+
+    @property
+    def left_over(self) -> list[int]:
+        """Slots the controller holds that the file does not define, kept (no --erase-unused)."""
+        from mercmac.upload.plan import Fate
+
+        return [s for s, fate in sorted(self.plan.fates.items()) if fate is Fate.KEPT]
+
+    def wire(self, address: int | None = None) -> list[tuple[bytes, str]]:
         """The exact bytes a flash sends after reading back, with what each is for."""
+        address = self.identity.address if address is None else address
         out = [(protocol.select(address), "address selection (0x01 + address)")]
         for step in self.plan.steps:
             out.append((protocol.command(step.wire), step.describe))
@@ -77,6 +90,14 @@ class Watch:
     def refused(self, compilation: Compilation) -> None:
         """The file has errors (for the controller's model): shown before the refusal."""
 
+    @contextmanager
+    def searching(self) -> Iterator[Callable[[int], None]]:
+        """No --address and nothing at 0: around the search of 1-15; yields where each goes."""
+        yield lambda address: None
+
+    def compiled(self, compilation: Compilation) -> None:
+        """The file as it will be flashed (no errors; it may have warnings to show)."""
+
     def identified(self, identity: Identity, warning: str | None) -> None:
         """The controller answered and fits the program; `warning`: it does not (--force)."""
 
@@ -89,7 +110,7 @@ class Watch:
         """The flash is complete; the port is still open (closing it may yet be cut short)."""
 
 
-def flash_file(port: str, path: str, *, address: int = 0, baud: int = DEFAULT_BAUD,
+def flash_file(port: str, path: str, *, address: int | None = 0, baud: int = DEFAULT_BAUD,
                timing: Timing = Timing(), options: FlashOptions | None = None,
                target: str | None = None, force: bool = False,
                watch: Watch | None = None) -> FlashResult:
@@ -97,37 +118,77 @@ def flash_file(port: str, path: str, *, address: int = 0, baud: int = DEFAULT_BA
 
     A file without `target` (and no `target` given) is compiled again for the model
     that answers, so that it is checked against that controller; a model other than
-    the program's is refused unless `force`. Refused, FlashFailed, FlashInterrupted or
+    the program's is refused unless `force`. `address` None: 0 if anything answers there,
+    else the only address that answers (survey.find_address). Refused, FlashFailed, FlashInterrupted or
     PortError say what happened; backup.BackupError: `options.backup` cannot be written
     (checked before the port is opened); OSError: the file cannot be read.
     """
     watch = watch or Watch()
     options = options or FlashOptions()
-    program = _compile(path, target, watch)
+    compiled = _compile(path, target, watch)
+    program = compiled.program
+    if program.target is not None:  # else compiled again below, for the model that answers
+        watch.compiled(compiled)
     if options.backup is not None:
         backup.check(options.backup)  # a device, FIFO or folder: refused before the port opens
-    with open_controller(port, address, baud=baud, timing=timing) as c:
+    with open_controller(port, address or 0, baud=baud, timing=timing) as c:
         try:
+            if address is None:
+                from mercmac.upload.survey import find_address
+
+                with watch.searching() as searched:
+                    c.address = find_address(c.transport, searched)
             who = identify(c)
             if program.target is None:
-                program = _compile(path, who.version.model, watch)
+                compiled = _compile(path, who.version.model, watch)
+                program = compiled.program
+                watch.compiled(compiled)
             watch.identified(who, check_model(who, program.target, path, force=force))
         except KeyboardInterrupt:
             raise FlashInterrupted("interrupted before the first write; nothing was written") from None
         with watch.writing() as notify:
             result = flash(c, who, program, options, notify)
+            result.restoring = _is_backup(path)
+            if not options.dry_run:
+                result.recorded = _record(c, who, compiled, result)
             watch.finished(result)
     return result
 
 
-def _compile(path: str, target: str | None, watch: Watch) -> Program:
-    """The program of PATH for `target`; Refused (after `watch.refused`) if it has errors."""
+def _record(controller: Controller, identity: Identity, compiled: Compilation,
+            result: FlashResult) -> Path | None:
+    """Note the verified flash in the history (mercmac.upload.history); None if it cannot be."""
+    from mercmac import outfile
+    from mercmac.upload import history
+
+    try:
+        return history.record(port=controller.transport.port, address=controller.address,
+                              model=identity.version.model, firmware=identity.version.firmware,
+                              file=compiled.source.name, source=compiled.source.text,
+                              build=compiled.program.md_lines(),
+                              backup_path=result.backup)
+    except (OSError, outfile.OutputError):
+        return None  # the flash is done and verified; a history that cannot be written is no failure
+
+
+def _is_backup(path: str) -> bool:
+    """Whether PATH was written by `mercmac pull` or a flash's backup (backup.to_mcm's header)."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            head = [f.readline() for _ in range(2)]
+    except OSError:
+        return False
+    return head[0].startswith("// Mercury(TM) Macro File") and head[1].startswith("// read by mercmac")
+
+
+def _compile(path: str, target: str | None, watch: Watch) -> Compilation:
+    """PATH compiled for `target`; Refused (after `watch.refused`) if it has errors."""
     compilation = compile_file(path, target=target)
     if compilation.report.has_errors or compilation.program is None:
         watch.refused(compilation)
         against = f" for the {target}" if target else ""
         raise Refused(f"{path} has errors{against}; nothing was flashed")
-    return compilation.program
+    return compilation
 
 
 def flash(controller: Controller, identity: Identity, program: Program,
@@ -178,14 +239,18 @@ class _Run:
 
     def execute(self) -> None:
         total = len(self.plan.steps)
+        sizes = [len(protocol.command(s.wire)) + len(protocol.command(s.readback))
+                 for s in self.plan.steps]
+        size, sent = sum(sizes), 0
         try:
             for i, step in enumerate(self.plan.steps):
                 self.current = step
-                self.notify(Event("step", step.describe, i, total))
+                self.notify(Event("step", step.describe, i, total, sent, size))
                 self._apply(step)
                 self.done.append(step)
                 self.current = None
-                self.notify(Event("verified", f"{step.describe}: verified", i + 1, total))
+                sent += sizes[i]
+                self.notify(Event("verified", f"{step.describe}: verified", i + 1, total, sent, size))
         except KeyboardInterrupt:
             kind, cause, alive = FlashInterrupted, "interrupted (Ctrl-C)", True
         except _Mismatch as e:

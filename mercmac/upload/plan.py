@@ -40,9 +40,11 @@ class Step:
 
     @property
     def describe(self) -> str:
-        """'write MC05', 'erase MC07', 'remove autostart MC00 until the end'."""
+        """'write MC05', 'erase MC07', 'remove the autostart macro MC00 first'."""
         if self.action is Action.PARK:
-            return f"remove {self.name} (autostart) until the end"
+            # the program's label of macro 0 may already say so: 'autostart (MC00)'
+            what = self.name if "autostart" in self.name else f"the autostart macro {self.name}"
+            return f"remove {what} first"
         return f"{self.action.value} {self.name}"
 
     @property

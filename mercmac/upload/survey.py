@@ -1,17 +1,21 @@
 """Looking without writing: `pull` a controller's macros, `scan` addresses, list `ports`."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Callable
 
+from mercmac.errors import UsageError
 from mercmac.upload import backup
-from mercmac.upload.controller import BadReply, Controller, ControllerError, Flood, LinkLost
-from mercmac.upload.errors import UploadError
+from mercmac.upload.controller import (BadReply, Controller, ControllerError, Flood, LinkLost,
+                                       NoAnswer)
+from mercmac.upload.errors import Refused, UploadError
 from mercmac.upload.protocol import Status, Version
 from mercmac.upload.connect import Identity, identify, refusal
 from mercmac.upload.transport import Transport
 
 PI_VENDOR = 0x1A72  # USB vendor id of Physik Instrumente
 PI_PRODUCTS = {0x1007: "C-863"}  # USB product ids known to be Mercury controllers
+SEARCH_TIMEOUT = 0.3  # s: the longest wait at each address when looking for the controller
 
 
 @dataclass(frozen=True, slots=True)
@@ -51,14 +55,18 @@ class Found:
         return self.status.layout if self.status else "?"
 
 
-def scan(transport: Transport, addresses=range(16), *, stop: bool = False) -> list[Found]:
+def scan(transport: Transport, addresses=range(16), *, stop: bool = False,
+         on_address: Callable[[int], None] | None = None) -> list[Found]:
     """Which addresses answer `%`; VE for those not running a macro (or all, with stop).
 
     An address whose answer is not a status report is listed with what came; a flood
     of such replies ends the scan there, as the line carries nothing readable.
+    `on_address(n)` is told each address before it is probed (a progress line).
     """
     found = []
     for address in addresses:
+        if on_address:
+            on_address(address)
         controller = Controller(transport, address)
         status = None
         try:
@@ -80,6 +88,54 @@ def scan(transport: Transport, addresses=range(16), *, stop: bool = False) -> li
             if status:
                 found.append(Found(address, status, None, f"VE: {e}"))
     return found
+
+
+def find_address(transport: Transport,
+                 on_address: Callable[[int], None] | None = None) -> int:
+    """The address to use when none was given: 0 if anything answers there (the default
+    of old, and no search), else the only one of 1-15 that answers `%`.
+
+    Addresses 1-15 are probed with at most SEARCH_TIMEOUT each (about 5 s in all).
+    Refused when none answers; UsageError (exit 2) when several do: say which with --address.
+    """
+    at_zero = Controller(transport, 0)
+    try:
+        at_zero.select()
+        at_zero.probe()  # '%' does not stop a running macro (§6.3)
+        return 0
+    except LinkLost as e:
+        raise refusal(at_zero, e) from None
+    except NoAnswer:
+        pass  # nobody at 0: search 1-15
+    except ControllerError:
+        return 0  # an answer at 0, even a garbled one: 0, as without the search (identify says why)
+    timing = transport.timing
+    transport.timing = replace(timing, timeout=min(timing.timeout, SEARCH_TIMEOUT))
+    try:
+        found = scan(transport, range(1, 16), on_address=on_address)
+    except UploadError as e:
+        raise Refused(f"the port failed while looking for the controller: {e}; nothing was written",
+                      hint="check the cable and that the USB adapter is still there") from None
+    finally:
+        transport.timing = timing
+    answering = [f for f in found if f.status]
+    if len(answering) == 1:
+        return answering[0].address
+    where = f"on {transport.port}"
+    if answering:
+        listed = ", ".join(f"{f.address} ({f.model})" for f in answering)
+        raise UsageError(f"no --address given, and {len(answering)} controllers answer {where}: "
+                         f"addresses {listed}; nothing was written",
+                         hint=f"say which one: --address {answering[0].address}")
+    if found:
+        raise Refused(f"no controller answers like a Mercury at addresses 0-15 {where} "
+                      f"(garbled replies at {', '.join(str(f.address) for f in found)}); "
+                      f"nothing was written",
+                      hint=f"a baud rate other than the controller's garbles replies: check "
+                           f"DIP switches 5-6 against --baud {transport.baud}")
+    raise Refused(f"nothing answers at addresses 0-15 {where}; nothing was written",
+                  hint=f"check power and cable, and that DIP switches 5-6 set the baud rate "
+                       f"{transport.baud}")
 
 
 def answered(found: list[Found]) -> bool:

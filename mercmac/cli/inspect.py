@@ -1,0 +1,228 @@
+"""`mercmac decompile`, `describe` and `history`: what a file or a controller holds (SPEC §5).
+
+The macros come from a .mcm file (raw `[MCnn]` blocks such as a pull or a backup, or
+a program) or from the controller on --port. A controller that holds exactly a
+program mercmac flashed gets that source back (mercmac.upload.history).
+"""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+
+import click
+
+from mercmac.cli.common import FiniteFloat, run_guarded
+from mercmac.errors import EXIT_FAILED, EXIT_OK, UsageError
+
+_SOURCE = [
+    click.argument("file", required=False, type=click.Path(dir_okay=False, allow_dash=True)),
+    click.option("--port", help="Read the controller on this port instead of a file."),
+    click.option("--address", type=click.IntRange(0, 15), default=0, show_default=True,
+                 help="Controller address, DIP switches 1-4 (with --port)."),
+    click.option("--baud", type=click.IntRange(300, 921_600), default=9600, show_default=True,
+                 help="Baud rate, DIP switches 5-6 (with --port)."),
+    click.option("--timeout", type=FiniteFloat(0.05, 60), default=1.0, show_default=True,
+                 help="Seconds to wait for each reply (with --port)."),
+]
+
+
+def _from_file_or_port(command):
+    for decorate in reversed(_SOURCE):
+        command = decorate(command)
+    return command
+
+
+class _Refused(Exception):
+    """The file has errors; they are shown already (exit 1)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Macros:
+    """What was read, and from where."""
+
+    macros: dict[int, str]
+    model: str | None
+    origin: str  # the file, or 'PORT, address N'
+    port: str | None = None
+    address: int | None = None
+
+
+def _read(file: str | None, port: str | None, address: int, baud: int, timeout: float) -> Macros:
+    """The macros of FILE or of the controller on PORT; UsageError for neither or both."""
+    if (file is None) == (port is None):
+        raise UsageError("give a FILE or --port PORT" if file is None else
+                         "give a FILE or --port PORT, not both",
+                         hint="FILE is a .mcm file, such as one `mercmac pull` wrote")
+    if file is not None:
+        return _read_file(file)
+    from mercmac.upload import connect, survey
+    from mercmac.upload.transport import Timing
+
+    timing = Timing(timeout=timeout, settle=min(0.25, timeout))
+    with connect.open_controller(port, address, baud=baud, timing=timing) as c:
+        pulled = survey.pull(c)
+    return Macros(pulled.macros, pulled.identity.version.model, f"{port}, address {address}",
+                  port, address)
+
+
+def _read_file(file: str) -> Macros:
+    from mercmac.compiler import compile_file
+    from mercmac.render import report as render
+
+    compilation = compile_file(file)  # OSError: exit 2 with the reason
+    if render.write_errors(compilation) or compilation.program is None:
+        raise _Refused()
+    program = compilation.program
+    macros = {m.slot: m.line for m in program.macros.values()}
+    return Macros(macros, program.target, compilation.source.name)
+
+
+def _recorded(read: Macros):
+    """The history record of exactly these macros, said on standard error; else None."""
+    from mercmac.upload import history
+
+    found = history.lookup(read.macros, port=read.port, address=read.address)
+    if found:
+        click.echo(f"mercmac: {read.origin} holds {found.label}", err=True)
+    return found
+
+
+def _library():
+    """mercmac.decompile, or UsageError when this installation has none."""
+    try:
+        from mercmac import decompile
+    except ImportError:
+        raise UsageError("this mercmac has no decompiler (mercmac.decompile is missing)",
+                         hint="reinstall mercmac") from None
+    return decompile
+
+
+def _write(text: str, output: str | None) -> None:
+    if output and output != "-":
+        from mercmac import outfile
+
+        outfile.write_text(output, text)  # whole or not at all; OutputError: exit 2
+    else:
+        click.echo(text, nl=False)
+
+
+def _guarded(work) -> None:
+    def guarded() -> int:
+        try:
+            return work()
+        except _Refused:
+            return EXIT_FAILED
+
+    run_guarded(guarded)
+
+
+@click.command()
+@_from_file_or_port
+@click.option("-o", "--output", type=click.Path(dir_okay=False, allow_dash=True),
+              help="Write the source to this file instead of standard output.")
+def decompile(file, port, address, baud, timeout, output) -> None:
+    """Turn raw macros back into high-level source that builds to exactly the same macros.
+
+    FILE is a .mcm file of `[MCnn]` blocks (a pull, a backup); --port reads the
+    controller instead. A controller or file that holds exactly a program
+    `mercmac flash` wrote gives back that source, with its names and comments.
+    Exit 1 when FILE has errors, 2 when it cannot be read or nothing answers.
+    """
+    def work() -> int:
+        read = _read(file, port, address, baud, timeout)
+        found = _recorded(read)
+        if found:
+            text = found.source
+        else:
+            text = _library().decompile(read.macros, model=read.model, origin=read.origin)
+        _write(text if text.endswith("\n") or not text else text + "\n", output)
+        return EXIT_OK
+
+    _guarded(work)
+
+
+@click.command()
+@_from_file_or_port
+@click.option("--format", "fmt", type=click.Choice(["text", "markdown", "json"]), default="text",
+              show_default=True, help="text for people, markdown for documents, json for programs.")
+@click.option("--graph", type=click.Path(dir_okay=False),
+              help="Also write the call graph: FILE.dot as Graphviz text, FILE.svg drawn by "
+                   "Graphviz's `dot` (which must be installed).")
+def describe(file, port, address, baud, timeout, fmt, graph) -> None:
+    """Say what a program does: its macros, what calls what, inputs, outputs and moves.
+
+    FILE is a .mcm file; --port reads the controller instead.
+    """
+    def work() -> int:
+        graph_kind = _graph_kind(graph) if graph else None  # refused before the port is read
+        read = _read(file, port, address, baud, timeout)
+        library = _library()
+        text = library.describe(read.macros, model=read.model, fmt=fmt)
+        if graph:
+            _write_graph(library.call_graph_dot(read.macros, model=read.model), graph, graph_kind)
+        click.echo(text, nl=not text.endswith("\n"))
+        if graph:
+            click.echo(f"mercmac: call graph written to {graph}", err=True)
+        return EXIT_OK
+
+    _guarded(work)
+
+
+def _graph_kind(path: str) -> str:
+    """'dot' or 'svg' from the name; UsageError for others, or svg without Graphviz."""
+    import shutil
+
+    kind = path.rsplit(".", 1)[-1].lower() if "." in path else ""
+    if kind not in ("dot", "gv", "svg"):
+        raise UsageError(f"--graph {path}: give a .dot or .svg file",
+                         hint=".dot is Graphviz text; .svg is drawn by Graphviz's `dot`")
+    if kind == "svg" and shutil.which("dot") is None:
+        raise UsageError("--graph .svg needs Graphviz's `dot` program, which is not installed",
+                         hint="install Graphviz (graphviz.org), or write a .dot file and draw "
+                              "it elsewhere")
+    return "svg" if kind == "svg" else "dot"
+
+
+def _write_graph(dot: str, path: str, kind: str) -> None:
+    from mercmac import outfile
+
+    if kind == "dot":
+        outfile.write_text(path, dot)
+        return
+    import shutil
+    import subprocess
+
+    try:
+        drawn = subprocess.run([shutil.which("dot") or "dot", "-Tsvg"], input=dot.encode(),
+                               capture_output=True, timeout=60, check=False)
+    except (OSError, subprocess.SubprocessError) as e:
+        raise UsageError(f"Graphviz's `dot` could not draw the call graph: {e}") from None
+    if drawn.returncode != 0:
+        said = drawn.stderr.decode(errors="replace").strip()[:300]
+        raise UsageError(f"Graphviz's `dot` could not draw the call graph: {said}")
+    with outfile.replacing(path, binary=True) as f:
+        f.write(drawn.stdout)
+
+
+@click.command()
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
+              show_default=True, help="A table for people, or JSON.")
+def history(fmt) -> None:
+    """List what `mercmac flash` wrote where, newest first.
+
+    Records are kept in the per-user data directory (or $MERCMAC_DATA_DIR), beside
+    the backups.
+    """
+    def work() -> int:
+        from mercmac.render import history as view
+        from mercmac.render.console import write_lines
+        from mercmac.upload import history as records
+
+        found = records.records()
+        if fmt == "json":
+            click.echo(view.to_json(found))
+        else:
+            write_lines(view.table_lines(found), sys.stdout)
+        return EXIT_OK
+
+    run_guarded(work)

@@ -1,0 +1,143 @@
+"""A stored program read back: its lines as ops, who calls whom, and names for its macros."""
+from __future__ import annotations
+
+import re
+from typing import NamedTuple
+
+from mercmac import mdtext
+from mercmac.commands import C663, C863, MODELS, Mnemonic, lookup
+
+CONDITIONS = (Mnemonic.XN, Mnemonic.XF)
+_HEADER = re.compile(r"\s*(?:\[\s*MC\s*\+?\s*(\d+)\s*\]|MC\s*(\d+)\b|MD\s*(\d+)\s*(?:,|$))(.*)",
+                     re.IGNORECASE)
+
+
+class Line(NamedTuple):
+    """One slot as stored: its normal text and, when it reads as commands, its ops."""
+
+    slot: int
+    text: str
+    ops: tuple | None  # None: the line has errors and stays a raw block
+
+    def ems(self) -> list[int]:
+        return [op.arg for op in self.ops or () if op.mnemonic == Mnemonic.EM]
+
+
+def read_macros(text: str) -> dict[int, str]:
+    """The macros of a `[MCnn]` file, `MDn,...` lines or a `TM` report, by slot (last wins)."""
+    macros: dict[int, str] = {}
+    for raw in text.splitlines():
+        m = _HEADER.match(raw.split("//", 1)[0])
+        if m and any(m.group(i) for i in (1, 2, 3)):
+            slot = int(next(g for g in m.groups()[:3] if g))
+            macros[slot] = m.group(4).strip()
+    return macros
+
+
+def read_lines(macros: dict[int, str]) -> dict[int, Line]:
+    lines = {}
+    for slot, text in sorted(macros.items()):
+        norm = mdtext.normal(text)
+        parsed = mdtext.parse_line(norm, slot=slot)
+        lines[slot] = Line(slot, norm, None if parsed.errors or not norm else tuple(parsed.ops))
+    return lines
+
+
+def model_of(lines: dict[int, Line], model: str | None) -> str | None:
+    """The model a `VE` named, else the one model that has every command used."""
+    if model:
+        found = [m for m in MODELS if m.replace("-", "") in model.upper().replace("-", "")]
+        if found:
+            return found[0]
+    fits = set(MODELS)
+    for line in lines.values():
+        for op in line.ops or ():
+            fits &= lookup(op.mnemonic).models
+    return next(iter(fits)) if len(fits) == 1 else None
+
+
+def callers(lines: dict[int, Line]) -> dict[int, list[int]]:
+    """slot -> the slots whose lines EM to it (one entry per EM)."""
+    out: dict[int, list[int]] = {}
+    for line in lines.values():
+        for target in line.ems():
+            out.setdefault(target, []).append(line.slot)
+    return out
+
+
+def condition_run(ops) -> list:
+    """The XN/XF commands a line starts with."""
+    run = []
+    for op in ops or ():
+        if op.mnemonic not in CONDITIONS:
+            break
+        run.append(op)
+    return run
+
+
+def every_period(ops) -> int | None:
+    """T when the line is `...,WA T,RP,RP` (an `every T` loop), else None."""
+    ops = ops or ()
+    if len(ops) >= 3 and [(o.mnemonic, o.arg) for o in ops[-2:]] == [(Mnemonic.RP, None)] * 2 \
+            and ops[-3].mnemonic == Mnemonic.WA:
+        return ops[-3].arg
+    return None
+
+
+def button_words(ops) -> str:
+    """'1', '2_and_3', 'not_2': the inputs of a condition run, for a name."""
+    return "_and_".join(("not_" if op.mnemonic == Mnemonic.XF else "") + str(op.arg) for op in ops)
+
+
+def names(lines: dict[int, Line]) -> dict[int, str]:
+    """A stable, unique name for each slot, made from what its line does."""
+    calls = callers(lines)
+    modes: dict[int, str] = {}
+    for line in lines.values():  # a loop entered by a tail EM of a conditioned line: a mode
+        run = condition_run(line.ops)
+        if run and line.ops and line.ops[-1].mnemonic == Mnemonic.EM:
+            modes.setdefault(line.ops[-1].arg, button_words(run))
+    out: dict[int, str] = {}
+    used: set[str] = set()
+    # What a loop answers is named after the loop: the loops are named first.
+    answers = {s for s, line in lines.items() if condition_run(line.ops)
+               and len(calls.get(s, ())) == 1 and every_period(lines[calls[s][0]].ops) is not None}
+    for slot, line in sorted(lines.items(), key=lambda item: (item[0] in answers, item[0])):
+        if slot in answers:
+            base = f"{out[calls[slot][0]]}_button_{button_words(condition_run(line.ops))}"
+        else:
+            base = "autostart" if slot == 0 else _name(line, modes.get(slot),
+                                                       0 in calls.get(slot, ()))
+        name, n = base, 2
+        while name in used:
+            name, n = f"{base}_{n}", n + 1
+        used.add(name)
+        out[slot] = name
+    return dict(sorted(out.items()))
+
+
+def _name(line: Line, mode: str | None, from_autostart: bool) -> str:
+    ops = line.ops or ()
+    run = condition_run(ops)
+    if run:
+        words = button_words(run)
+        return f"on_button_{words}" if all(o.arg <= 4 for o in run) else f"on_input_{words}"
+    period = every_period(ops)
+    if period is not None:
+        return f"mode_{mode}" if mode else f"poll_{period}ms"
+    mnemonics = {op.mnemonic for op in ops}
+    if ops and all(lookup(m).kind.value in ("setting", "motion", "wait") for m in mnemonics) \
+            and mnemonics & {Mnemonic.SV, Mnemonic.SA, Mnemonic.FE, Mnemonic.DP, Mnemonic.BF}:
+        return "init" if from_autostart else "settings"
+    if ops and all(lookup(m).kind.value in ("output", "wait") for m in mnemonics):
+        return "pulse" if mnemonics & {Mnemonic.CN, Mnemonic.CF} else "leds"
+    if Mnemonic.RP in mnemonics:
+        return "loop"
+    if ops and mnemonics == {Mnemonic.EM}:
+        return "dispatch"
+    if mnemonics & {Mnemonic.MA, Mnemonic.MR, Mnemonic.GH}:
+        return "move"
+    return f"mc{line.slot:02d}"
+
+
+__all__ = ["C663", "C863", "Line", "read_macros", "read_lines", "model_of", "names"]

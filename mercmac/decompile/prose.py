@@ -1,0 +1,273 @@
+"""A stored program in plain words (issue 12): every macro the way the manual's §3.8.6
+describes its examples, grouped as a person reads a program."""
+from __future__ import annotations
+
+import json
+
+from mercmac.commands import C663, Mnemonic, lookup
+from mercmac.decompile.lines import (Line, condition_run, every_period, model_of, names,
+                                     read_lines)
+
+_UNITS = {C663: "steps"}  # MS176E §3: the C-663 counts microsteps, the C-863 encoder counts
+
+
+class _Reader:
+    def __init__(self, macros: dict[int, str], model: str | None):
+        self.lines = read_lines(macros)
+        self.model = model_of(self.lines, model)
+        self.unit = _UNITS.get(self.model, "counts") if self.model else "counts"
+        self.names = names(self.lines)
+
+    # -- words for one line -------------------------------------------------------------------------
+    def label(self, slot: int) -> str:
+        return f"MC{slot:02d} ({self.names[slot]})" if slot in self.lines else f"MC{slot:02d}"
+
+    def words(self, line: Line) -> str:
+        if line.ops is None:
+            return "cannot be read as commands: " + (line.text or "empty")
+        if not line.ops:
+            return "does nothing"
+        return self.phrase(list(line.ops))
+
+    def phrase(self, ops: list) -> str:
+        run = condition_run(ops)
+        if run:
+            rest = ops[len(run):]
+            return f"only while {_condition(run)}: " + (self.phrase(rest) if rest else "nothing")
+        period = every_period(ops)
+        if period is not None and not any(o.mnemonic == Mnemonic.RP for o in ops[:-3]):
+            body = self.steps(ops[:-3])
+            return f"every {period} ms, forever: " + (_series(body) if body else "wait")
+        steps, i = [], 0
+        for i, op in enumerate(ops):
+            run = condition_run(ops[i:])
+            if run:
+                steps.append(f"only while {_condition(run)}: "
+                             + self.phrase(ops[i + len(run):]))
+                return _series(steps)
+            steps.append(self.command(op, tail=i == len(ops) - 1))
+        return _series(steps)
+
+    def steps(self, ops: list) -> list[str]:
+        return [self.command(op, tail=False) for op in ops]
+
+    def command(self, op, tail: bool) -> str:
+        m, n, unit = op.mnemonic, op.arg, self.unit
+        if m == Mnemonic.EM:
+            target = self.lines.get(n)
+            if target is None:
+                return f"run MC{n:02d} (not defined: nothing happens)"
+            run = condition_run(target.ops)
+            when = f" if {_condition(run, at_start=True)}" if run and len(run) < len(target.ops) else ""
+            return ("go to " if tail else "run ") + self.label(n) + when
+        if m == Mnemonic.MR:
+            return f"move {n:+,} {unit}"
+        if m == Mnemonic.MA:
+            return f"move to position {n:,}"
+        if m == Mnemonic.GH:
+            return "go home (position 0)"
+        if m == Mnemonic.DH:
+            return f"make the current position {n or 0}"
+        if m == Mnemonic.AB:
+            return "stop smoothly" if n == 1 else "stop at once"
+        if m == Mnemonic.SV:
+            return f"set the velocity to {n:,} {unit}/s"
+        if m == Mnemonic.SA:
+            return f"set the acceleration to {n:,} {unit}/s²"
+        if m == Mnemonic.WA:
+            return f"wait {n:,} ms"
+        if m == Mnemonic.WS:
+            return f"wait until on target and {1000 if n is None else n} ms more"
+        if m in (Mnemonic.WF, Mnemonic.WN):
+            return f"wait until button {n} is {'released' if m == Mnemonic.WF else 'pressed'}"
+        if m == Mnemonic.CP:
+            return _leds(n)
+        if m in (Mnemonic.CN, Mnemonic.CF):
+            return f"LED {n} {'on' if m == Mnemonic.CN else 'off'}"
+        if m == Mnemonic.RP:
+            return ("repeat the line 65,535 more times" if n is None
+                    else f"repeat the line {n:,} more time{'s' if n != 1 else ''}")
+        if m == Mnemonic.FE:
+            return f"search the reference (FE{0 if n is None else n})"
+        summary = lookup(m).summary.split(":")[0].split(" (")[0]
+        return f"{summary[0].lower()}{summary[1:]} ({op.text})"
+
+    # -- the program ----------------------------------------------------------------------------------
+    def reached(self) -> set[int]:
+        seen, todo = set(), [0] if 0 in self.lines else []
+        while todo:
+            s = todo.pop()
+            if s in seen or s not in self.lines:
+                continue
+            seen.add(s)
+            todo += self.lines[s].ems()
+        return seen
+
+    def startup(self) -> set[int]:
+        """The macros macro 0 reaches before any polling loop: what runs once at power-on."""
+        seen, todo = set(), [0] if 0 in self.lines else []
+        while todo:
+            s = todo.pop()
+            if s in seen or s not in self.lines or every_period(self.lines[s].ops) is not None:
+                continue
+            seen.add(s)
+            todo += self.lines[s].ems()
+        return seen
+
+    def modes(self) -> list[dict]:
+        """Loops entered by a tail EM of a line that a button selects."""
+        out = []
+        for line in self.lines.values():
+            run = condition_run(line.ops)
+            if run and line.ops[-1].mnemonic == Mnemonic.EM:
+                target = line.ops[-1].arg
+                if target in self.lines:
+                    out.append({"mode": target, "name": self.names[target], "by": line.slot,
+                                "condition": _condition(run, at_start=True),
+                                "first": self.phrase(list(line.ops[len(run):-1])) or "",
+                                "at_power_on": line.slot in self.startup()})
+        return out
+
+    def loops(self) -> list[dict]:
+        out = []
+        for line in self.lines.values():
+            period = every_period(line.ops)
+            if period is None:
+                continue
+            answers = []
+            for target in line.ems():
+                t = self.lines.get(target)
+                run = condition_run(t.ops if t else None)
+                if t is not None and run:
+                    answers.append({"slot": target, "condition": _condition(run, at_start=True),
+                                    "does": self.phrase(list(t.ops[len(run):]))})
+            out.append({"slot": line.slot, "name": self.names[line.slot], "period_ms": period,
+                        "answers": answers})
+        return out
+
+    def leds(self) -> list[dict]:
+        out = []
+        for line in self.lines.values():
+            lit = [_leds(op.arg) if op.mnemonic == Mnemonic.CP else f"LED {op.arg} on"
+                   for op in line.ops or () if op.mnemonic in (Mnemonic.CP, Mnemonic.CN)]
+            if lit:
+                out.append({"slot": line.slot, "name": self.names[line.slot], "lights": lit})
+        return out
+
+    def data(self) -> dict:
+        reached = self.reached()
+        return {
+            "model": self.model, "unit": self.unit,
+            "power_on": ({"slot": 0, "does": self.words(self.lines[0])}
+                         if 0 in self.lines else None),
+            "modes": self.modes(), "loops": self.loops(), "leds": self.leds(),
+            "unreached": [s for s in self.lines if s not in reached and 0 in self.lines],
+            "macros": [{"slot": s, "name": self.names[s], "line": line.text,
+                        "does": self.words(line), "calls": line.ems(),
+                        "reached": s in reached} for s, line in self.lines.items()],
+        }
+
+
+def _condition(run, at_start: bool = False) -> str:
+    on = [str(o.arg) for o in run if o.mnemonic == Mnemonic.XN]
+    off = [str(o.arg) for o in run if o.mnemonic == Mnemonic.XF]
+    parts = []
+    if on:
+        parts.append(f"button {on[0]} is held" if len(on) == 1
+                     else f"buttons {' and '.join(on)} are held")
+    if off:
+        parts.append(f"button {off[0]} is not pressed" if len(off) == 1
+                     else f"buttons {' and '.join(off)} are not pressed")
+    return " and ".join(parts).replace("button 5", "the joystick input").replace(
+        "button 6", "the joystick button")
+
+
+def _leds(pattern: int) -> str:
+    lit = [str(i + 1) for i in range(4) if pattern >> i & 1]
+    if not lit:
+        return "all LEDs off"
+    return (f"LED {lit[0]}" if len(lit) == 1 else f"LEDs {', '.join(lit[:-1])} and {lit[-1]}") \
+        + " on, the others off"
+
+
+def _series(steps: list[str]) -> str:
+    """'a, b, then c': the manual's way of saying one command after another."""
+    if len(steps) <= 1:
+        return "".join(steps)
+    return ", ".join(steps[:-1]) + ", then " + steps[-1].removeprefix("then ")
+
+
+# -- renderings ------------------------------------------------------------------------------------
+
+def describe(macros: dict[int, str], *, model: str | None = None, fmt: str = "text") -> str:
+    reader = _Reader(macros, model)
+    data = reader.data()
+    if fmt == "json":
+        return json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+    if fmt not in ("text", "markdown"):
+        raise ValueError(f"unknown format {fmt!r}: text, markdown or json")
+    md = fmt == "markdown"
+    out = [("# " if md else "") + _title(reader, data)]
+    for head, items in _sections(reader, data):
+        if not items:
+            continue
+        out += ["", f"## {head}" if md else f"{head}:"]
+        out += [("- " if md else "  ") + item for item in items]
+    if md:
+        out += ["", "## Call graph", "", "```mermaid", _mermaid(reader), "```"]
+    return "\n".join(out) + "\n"
+
+
+def _title(reader: _Reader, data: dict) -> str:
+    model = f"a {reader.model}" if reader.model else "a Mercury controller (model unknown)"
+    return f"{len(reader.lines)} macros for {model}; distances in {reader.unit}"
+
+
+def _sections(reader: _Reader, data: dict) -> list[tuple[str, list[str]]]:
+    label = reader.label
+    power = [f"{label(0)}: {data['power_on']['does']}"] if data["power_on"] else [
+        "nothing: there is no macro 0, so nothing runs by itself"]
+    modes, ways = [], {}
+    for m in data["modes"]:
+        when = " at power-on" if m["at_power_on"] else ""
+        first = f", which first does: {m['first']}" if m["first"] else ""
+        by = f"MC{m['by']:02d} {reader.names[m['by']]}"
+        ways.setdefault(m["mode"], []).append(f"{m['condition']}{when} (through {by}{first})")
+    for mode, how in ways.items():
+        modes.append(f"{label(mode)}: chosen while " + "; or while ".join(how))
+    loops = []
+    for loop in data["loops"]:
+        loops.append(f"{label(loop['slot'])}: every {loop['period_ms']} ms")
+        loops += [f"    while {a['condition']}, {label(a['slot'])}: {a['does']}"
+                  for a in loop["answers"]]
+    leds = [f"{label(x['slot'])}: " + "; ".join(x["lights"]) for x in data["leds"]]
+    every = [f"{label(m['slot'])}: {m['does']}" for m in data["macros"]]
+    never = [f"{label(s)}" for s in data["unreached"]]
+    return [("At power-on", power), ("Modes chosen by buttons", modes),
+            ("Polling loops and the buttons they answer", loops), ("LEDs", leds),
+            ("Every macro", every), ("Never reached from macro 0", never)]
+
+
+def _mermaid(reader: _Reader) -> str:
+    out = ["graph TD"]
+    for s, line in reader.lines.items():
+        out.append(f'    MC{s:02d}["MC{s:02d} {reader.names[s]}"]')
+    for s, line in reader.lines.items():
+        for i, t in enumerate(line.ems()):
+            tail = line.ops[-1].mnemonic == Mnemonic.EM and line.ops[-1].arg == t
+            out.append(f"    MC{s:02d} {'-.->' if tail else '-->'} MC{t:02d}")
+    return "\n".join(out)
+
+
+def call_graph_dot(macros: dict[int, str], *, model: str | None = None) -> str:
+    """The call graph as Graphviz dot: solid edges for calls, dashed for a tail EM (goto)."""
+    reader = _Reader(macros, model)
+    out = ["digraph macros {", "    node [shape=box];"]
+    for s in reader.lines:
+        out.append(f'    MC{s:02d} [label="MC{s:02d}\\n{reader.names[s]}"];')
+    for s, line in reader.lines.items():
+        for t in line.ems():
+            tail = line.ops[-1].mnemonic == Mnemonic.EM and line.ops[-1].arg == t
+            out.append(f"    MC{s:02d} -> MC{t:02d}" + (" [style=dashed];" if tail else ";"))
+    out.append("}")
+    return "\n".join(out) + "\n"

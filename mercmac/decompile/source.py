@@ -1,0 +1,343 @@
+"""Raw macros -> high-level .mcm source whose build stores the very same lines (issue 12).
+
+Each slot is written as richly as the round trip allows: a construct (`every`, `repeat`,
+`when` with its hoisted macros folded back, `call`, `goto`) only where compiling the
+source gives back the exact line in the exact slot; else a named macro of native
+commands; else the raw `[MCnn]` block, with a comment that says why. Every candidate
+is checked by compiling the whole source and comparing the slots.
+"""
+from __future__ import annotations
+
+from collections import Counter
+
+from mercmac import mdtext
+from mercmac.commands import Mnemonic
+from mercmac.compiler import compile_source
+from mercmac.decompile.lines import (CONDITIONS, Line, condition_run, every_period, model_of,
+                                     names, read_lines)
+from mercmac.diagnostics import Severity
+from mercmac.source import Source
+
+RAW, NATIVE, PLAIN, FOLD = 0, 1, 2, 3  # how richly a slot is written
+_LOOP_STOP = (Mnemonic.RP, Mnemonic.TI)  # what a loop body may not hold (RP, TI: the counter)
+
+
+class _Writer:
+    """Writes the source for one choice of levels (slot -> RAW..FOLD) and pins."""
+
+    def __init__(self, lines: dict[int, Line], names: dict[int, str], model: str | None):
+        self.lines, self.names, self.model = lines, names, model
+        self.levels = {s: RAW for s in lines}
+        self.pinned = {s: True for s in lines}
+        self.why: dict[int, str] = {}
+        self.fold_ok: set[int] = set(lines)  # helpers that may fold into their caller
+        self.counts = Counter(t for line in lines.values() for t in line.ems())
+
+    # -- which slots fold into their caller -----------------------------------------------------
+    def folds(self) -> dict[int, int]:
+        """helper slot -> caller slot, for hoisted `when` and loop macros (and the rest
+        after a loop that calls out) written back in their caller."""
+        out: dict[int, int] = {}
+        self.loops: dict[int, tuple] = {}
+        for line in self.lines.values():
+            if self.levels[line.slot] != FOLD:
+                continue
+            ops = line.ops
+            for i, op in enumerate(ops):
+                if op.mnemonic != Mnemonic.EM or not self._helper(op.arg, line.slot):
+                    continue
+                helper = self.lines[op.arg].ops
+                loop = self._loop(op.arg)
+                run = condition_run(helper)
+                if 0 < len(run) < len(helper):
+                    rest = helper[-1].arg if helper[-1].mnemonic == Mnemonic.EM else None
+                    if self._rest(rest, ops, i, line.slot, op.arg) and len(run) < len(helper) - 1:
+                        # a `when` that calls out, and the rest of the line after it
+                        out[op.arg] = out[rest] = line.slot
+                        self.loops[op.arg] = (f"when {_conditions(run)}", helper[len(run):-1],
+                                              rest, False)
+                    elif i < len(ops) - 1:  # a tail `when` would stand in its caller's line
+                        out[op.arg] = line.slot
+                elif loop and i and not _stops(ops[:i]) and every_period(ops) is None:
+                    rest = loop[2]
+                    if rest is None:  # a loop that calls nothing: the line goes on after it
+                        out[op.arg], self.loops[op.arg] = line.slot, loop
+                    elif self._rest(rest, ops, i, line.slot, op.arg):
+                        out[op.arg], self.loops[op.arg] = line.slot, loop
+                        out[rest] = line.slot
+        return out
+
+    def _rest(self, rest: int | None, ops, i: int, caller: int, helper: int) -> bool:
+        """Whether `rest` is the macro that both a hoisted block and its caller end in."""
+        return (rest is not None and i == len(ops) - 2 and ops[-1].arg == rest
+                and self.counts[rest] == 2 and rest not in (0, caller, helper)
+                and self.lines.get(rest) is not None and self.lines[rest].ops is not None
+                and self.levels[rest] != RAW)
+
+    def _helper(self, slot: int, caller: int) -> bool:
+        line = self.lines.get(slot)
+        return (line is not None and line.ops is not None and slot not in (0, caller)
+                and self.counts[slot] == 1 and self.levels[slot] != RAW
+                and slot in self.fold_ok)
+
+    def _loop(self, slot: int) -> tuple | None:
+        """(head, body, rest slot) of a hoisted `repeat N`/`every T` line, else None."""
+        ops = list(self.lines[slot].ops)
+        rest = None
+        if ops and ops[-1].mnemonic == Mnemonic.EM:
+            rest, ops = ops[-1].arg, ops[:-1]
+        period = every_period(ops)
+        if period is not None:
+            head, body = f"every {period}ms", ops[:-3]
+        elif ops and ops[-1].mnemonic == Mnemonic.RP and ops[-1].arg:
+            head, body = f"repeat {ops[-1].arg + 1}", ops[:-1]
+        else:
+            return None
+        if not body or _stops(body) or any(o.mnemonic in CONDITIONS for o in body):
+            return None
+        return head, body, rest, True
+
+    # -- the text -----------------------------------------------------------------------------------
+    def text(self) -> str:
+        self.folded = self.folds()
+        out = ["// Decompiled by mercmac: each macro names the slot it came from."]
+        if self.model:
+            out.append(f"target {self.model}")
+        for slot, line in sorted(self.lines.items()):
+            if slot in self.folded:
+                continue
+            out.append("")
+            out += self.item(line)
+        return "\n".join(out) + "\n"
+
+    def item(self, line: Line) -> list[str]:
+        level = self.levels[line.slot]
+        tag = f"MC{line.slot:02d}"
+        if level == RAW:
+            why = self.why.get(line.slot)
+            return [f"[{tag}] {line.text}" + (f"   // kept raw: {why}" if why else "")]
+        head = "autostart" if line.slot == 0 else f"macro {self.names[line.slot]}" + (
+            f" @{line.slot}" if self.pinned[line.slot] else "")
+        body = self.native(line.ops) if level == NATIVE else self.whole(line)
+        return [f"{head} {{   // {tag}"] + _indent(body) + ["}"]
+
+    def whole(self, line: Line) -> list[str]:
+        """A line at its start: a loop that starts it, then what follows."""
+        ops = list(line.ops)
+        for i, op in enumerate(ops):
+            if op.mnemonic == Mnemonic.RP:
+                period = every_period(ops[:i + 2])
+                if period is not None and i > 1 and not _stops(ops[:i - 1]):
+                    return (_block(f"every {period}ms", self.seq(ops[:i - 1], loop=True))
+                            + self.seq(ops[i + 2:], loop=False))
+                if op.arg and i and not _stops(ops[:i]) and not condition_run(ops[:i]):
+                    return (_block(f"repeat {op.arg + 1}", self.seq(ops[:i], loop=True))
+                            + self.seq(ops[i + 1:], loop=False))
+                break
+        return self.seq(ops, loop=False)
+
+    def seq(self, ops: list, loop: bool, hoisted: bool = False) -> list[str]:
+        """Statements for ops; `hoisted`: in a block that its own macro holds, where a tail
+        `call` would make the compiler continue the caller in another macro: a `goto`."""
+        out: list[str] = []
+        for i, op in enumerate(ops):
+            last = i == len(ops) - 1
+            run = condition_run(ops[i:])
+            if run and not loop and len(run) < len(ops) - i:
+                body = self.seq(ops[i + len(run):], loop=False, hoisted=hoisted)
+                return out + _block(f"when {_conditions(run)}", body)
+            before = _em_to(ops[i - 1]) if i else None
+            if before in self.loops and before in self.folded and self.loops[before][2] == op.arg:
+                continue  # the rest after a folded loop is written after it
+            if op.mnemonic == Mnemonic.EM:
+                out += self.em(op.arg, last and not loop, hoisted)
+            else:
+                out.append(_native(op))
+        return out
+
+    def em(self, slot: int, tail: bool, hoisted: bool = False) -> list[str]:
+        if slot in self.loops and slot in self.folded:
+            head, body, rest, loop = self.loops[slot]
+            block = _block(head, self.seq(list(body), loop=loop))
+            block[0] += f"   // MC{slot:02d}"
+            if rest is None:
+                return block
+            return block + [f"// MC{rest:02d}:"] + self.whole(self.lines[rest])
+        if slot in self.folded:
+            helper = self.lines[slot].ops
+            run = condition_run(helper)
+            body = self.seq(list(helper[len(run):]), loop=False, hoisted=True)
+            block = _block(f"when {_conditions(run)}", body)
+            block[0] += f"   // MC{slot:02d}"
+            return block
+        line = self.lines.get(slot)
+        if line is None or self.levels.get(slot, RAW) == RAW or slot == 0:
+            return [f"{Mnemonic.EM} {slot}"]
+        calls_on = bool(line.ems())
+        if tail:
+            goto = hoisted or calls_on or _never_returns(line)
+            return [f"{'goto' if goto else 'call'} {self.names[slot]}"]
+        return [f"{Mnemonic.EM} {slot}"] if calls_on else [f"call {self.names[slot]}"]
+
+    def native(self, ops) -> list[str]:
+        return [", ".join(_native(op) for op in ops)]
+
+
+def _em_to(op) -> int | None:
+    return op.arg if op.mnemonic == Mnemonic.EM else None
+
+
+def _never_returns(line: Line) -> bool:
+    return every_period(line.ops) is not None
+
+
+def _stops(ops) -> bool:
+    return any(op.mnemonic in _LOOP_STOP for op in ops)
+
+
+def _native(op) -> str:
+    return op.mnemonic if op.arg is None else f"{op.mnemonic} {op.arg}"
+
+
+def _conditions(run) -> str:
+    return " and ".join(("not " if op.mnemonic == Mnemonic.XF else "") + str(op.arg) for op in run)
+
+
+def _block(head: str, body: list[str]) -> list[str]:
+    body = _joined(body)
+    if len(body) == 1 and "{" not in body[0] and len(head) + len(body[0]) < 72:
+        return [f"{head} {{ {body[0]} }}"]
+    return [f"{head} {{"] + _indent(body) + ["}"]
+
+
+def _joined(body: list[str]) -> list[str]:
+    """Runs of simple statements on one line, `MR 5000, WS 100`, up to about 76 characters."""
+    out: list[str] = []
+    simple = False
+    for s in body:
+        plain = not s.startswith((" ", "//")) and "{" not in s and s != "}"
+        if plain and simple and len(out[-1]) + len(s) < 70:
+            out[-1] += ", " + s
+        else:
+            out.append(s)
+        simple = plain
+    return out
+
+
+def _indent(lines: list[str]) -> list[str]:
+    return ["    " + s for s in _joined(lines)]
+
+
+# -- checking a candidate ---------------------------------------------------------------------------
+
+class _Result:
+    def __init__(self, text: str, exact: bool, noise: Counter):
+        self.text, self.exact, self.noise = text, exact, noise
+
+
+def _check(writer: _Writer, want: dict[int, str]) -> _Result:
+    """Compile the writer's text: does it store `want`, and what warnings does it give?"""
+    text = writer.text()
+    comp = compile_source(Source("decompiled.mcm", text), writer.model)
+    noise = Counter(d.rule.name for d in comp.report.items
+                    if d.severity in (Severity.ERROR, Severity.WARNING))
+    got = {} if comp.program is None else {
+        m.slot: mdtext.normal(m.line) for m in comp.program.macros.values()}
+    return _Result(text, got == want, noise)
+
+
+def _no_worse(new: Counter, old: Counter) -> bool:
+    return all(new[k] <= old[k] for k in new)
+
+
+def decompile(macros: dict[int, str], *, model: str | None = None, origin: str = "") -> str:
+    """.mcm source whose `build` stores `macros` in the same slots (normalised lines)."""
+    lines = read_lines(macros)
+    writer = _Writer(lines, names(lines), model_of(lines, model))
+    want = {s: line.text for s, line in lines.items() if line.ops is not None}
+    for s, line in lines.items():
+        if line.ops is None:
+            writer.why[s] = ("an empty line" if not line.text
+                             else "the line does not read as commands")
+    stand_in = {s: line for s, line in lines.items()}
+    # Lines with errors stay raw and out of the check: a stand-in keeps their slot taken.
+    for s, line in lines.items():
+        if line.ops is None:
+            stand_in[s] = Line(s, "WA0", (mdtext.parse_line("WA0").ops))
+    checker = _Writer(stand_in, writer.names, writer.model)
+    want_check = {s: (line.text if line.ops is not None else "WA0") for s, line in lines.items()}
+    best = _check(checker, want_check)
+    if not best.exact:  # the raw form itself does not build back (cannot happen for valid lines)
+        return _finish(writer, origin)
+    valid = [s for s in sorted(lines) if lines[s].ops is not None]
+    trial = dict.fromkeys(valid, FOLD)
+    checker.levels.update(trial)
+    first = _check(checker, want_check)
+    if first.exact and _no_worse(first.noise, best.noise):
+        best = first
+    else:
+        checker.levels.update(dict.fromkeys(valid, RAW))
+        checker.fold_ok = set()
+        for _ in range(2):  # twice: a caller can name its callee once that has a name
+            for s in valid:
+                for level in (FOLD, PLAIN, NATIVE):
+                    if level <= checker.levels[s]:
+                        break
+                    old = checker.levels[s]
+                    checker.levels[s] = level
+                    result = _check(checker, want_check)
+                    if result.exact and _no_worse(result.noise, best.noise):
+                        best = result
+                        break
+                    checker.levels[s] = old
+        best = _fold(checker, want_check, best)
+    for s in valid:
+        if checker.levels[s] == RAW:
+            writer.why[s] = "a named form of it builds another line or adds a warning"
+    _unpin(checker, want_check, best)
+    writer.levels.update({s: checker.levels[s] for s in valid})
+    writer.pinned, writer.fold_ok = checker.pinned, checker.fold_ok
+    return _finish(writer, origin)
+
+
+def _fold(checker: _Writer, want: dict[int, str], best: _Result) -> _Result:
+    """Fold hoisted `when` macros into their callers one by one, where the slots allow."""
+    for s in sorted(checker.lines):
+        if checker.levels[s] == RAW or not s:
+            continue
+        checker.fold_ok.add(s)
+        before = dict(checker.levels)
+        result = _check(checker, want)
+        if result.exact and _no_worse(result.noise, best.noise):
+            best = result
+        else:
+            checker.fold_ok.discard(s)
+            checker.levels = before
+    return best
+
+
+def _unpin(checker: _Writer, want: dict[int, str], best: _Result) -> None:
+    """Drop the pins that the slot allocation makes needless (all at once, else one by one)."""
+    named = [s for s in checker.lines if s and checker.levels[s] != RAW]
+    checker.pinned.update(dict.fromkeys(named, False))
+    result = _check(checker, want)
+    if result.exact and _no_worse(result.noise, best.noise):
+        return
+    checker.pinned.update(dict.fromkeys(named, True))
+    for s in reversed(named):
+        checker.pinned[s] = False
+        result = _check(checker, want)
+        if not (result.exact and _no_worse(result.noise, best.noise)):
+            checker.pinned[s] = True
+
+
+def _finish(writer: _Writer, origin: str) -> str:
+    from mercmac.fmt import format_text
+
+    text = writer.text()
+    if origin:
+        text = f"// Read from {origin}.\n" + text
+    try:
+        return format_text(text)
+    except Exception:  # a raw block that does not parse keeps the text as written
+        return text
