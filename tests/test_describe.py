@@ -51,7 +51,8 @@ def test_unreached_macros_are_listed():
 
 def test_markdown_has_a_mermaid_call_graph():
     text = describe(_example4(), fmt="markdown")
-    assert "```mermaid" in text and "MC15 --> MC16" in text and text.startswith("# ")
+    assert "```mermaid" in text and "MC15 -->|call if button 1 is held| MC16" in text
+    assert 'MC15["MC15 mode_1 (every 20 ms)"]' in text and text.startswith("# ")
 
 
 def test_json_and_dot():
@@ -59,7 +60,8 @@ def test_json_and_dot():
     assert data["model"] == "C-863" and {m["mode"] for m in data["modes"]} == {15, 20, 26}
     assert [loop["period_ms"] for loop in data["loops"]] == [20, 100, 30]
     dot = call_graph_dot(_example4())
-    assert dot.startswith("digraph") and "MC10 -> MC14 [style=dashed];" in dot
+    assert dot.startswith("digraph") and 'MC10 -> MC14 [label="goto if button 4 is held", style=dashed];' in dot
+    assert 'MC15 [label="MC15\\nmode_1 (every 20 ms)"];' in dot
 
 
 def test_unknown_format():

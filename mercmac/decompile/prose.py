@@ -248,26 +248,53 @@ def _sections(reader: _Reader, data: dict) -> list[tuple[str, list[str]]]:
             ("Every macro", every), ("Never reached from macro 0", never)]
 
 
+def _edges(reader: _Reader):
+    """(caller, callee, label, tail) for every EM: `call` or `goto` (a tail EM, which never
+    returns), with the condition that guards it: the XN/XF before it in the caller's line
+    (a false one ends the line, MS176E §6.4 XN) and the one the callee starts with."""
+    for s, line in reader.lines.items():
+        guards = []
+        for i, op in enumerate(line.ops or ()):
+            if op.mnemonic in (Mnemonic.XN, Mnemonic.XF):
+                guards.append(op)
+            if op.mnemonic != Mnemonic.EM:
+                continue
+            tail = i == len(line.ops) - 1
+            callee = reader.lines.get(op.arg)
+            run = guards + condition_run(callee.ops if callee else ())
+            words = "goto" if tail else "call"
+            yield s, op.arg, words + (f" if {_condition(run)}" if run else ""), tail
+
+
+def _node(reader: _Reader, s: int) -> str:
+    """'MC15 mode_1' plus the loop it runs, if any: 'every 20 ms', 'repeat 10 times'."""
+    ops = reader.lines[s].ops or ()
+    period = every_period(ops)
+    rp = [o.arg for o in ops if o.mnemonic == Mnemonic.RP]
+    loop = f"every {period} ms" if period is not None else \
+        f"repeat {rp[0] + 1} times" if len(rp) == 1 and rp[0] is not None else ""
+    return f"MC{s:02d} {reader.names[s]}" + (f" ({loop})" if loop else "")
+
+
 def _mermaid(reader: _Reader) -> str:
     out = ["graph TD"]
-    for s, line in reader.lines.items():
-        out.append(f'    MC{s:02d}["MC{s:02d} {reader.names[s]}"]')
-    for s, line in reader.lines.items():
-        for i, t in enumerate(line.ems()):
-            tail = line.ops[-1].mnemonic == Mnemonic.EM and line.ops[-1].arg == t
-            out.append(f"    MC{s:02d} {'-.->' if tail else '-->'} MC{t:02d}")
+    for s in reader.lines:
+        out.append(f'    MC{s:02d}["{_node(reader, s)}"]')
+    for s, t, label, tail in _edges(reader):
+        out.append(f"    MC{s:02d} {'-.->' if tail else '-->'}|{label}| MC{t:02d}")
     return "\n".join(out)
 
 
 def call_graph_dot(macros: dict[int, str], *, model: str | None = None) -> str:
-    """The call graph as Graphviz dot: solid edges for calls, dashed for a tail EM (goto)."""
+    """The call graph as Graphviz dot: solid edges for calls, dashed for a tail EM (goto),
+    labelled with the condition that guards them; loops named on their macro."""
     reader = _Reader(macros, model)
-    out = ["digraph macros {", "    node [shape=box];"]
+    out = ["digraph macros {", "    rankdir=LR;", "    node [shape=box];",
+           "    edge [fontsize=10];"]
     for s in reader.lines:
-        out.append(f'    MC{s:02d} [label="MC{s:02d}\\n{reader.names[s]}"];')
-    for s, line in reader.lines.items():
-        for t in line.ems():
-            tail = line.ops[-1].mnemonic == Mnemonic.EM and line.ops[-1].arg == t
-            out.append(f"    MC{s:02d} -> MC{t:02d}" + (" [style=dashed];" if tail else ";"))
+        out.append(f'    MC{s:02d} [label="{_node(reader, s).replace(" ", chr(92) + "n", 1)}"];')
+    for s, t, label, tail in _edges(reader):
+        style = ", style=dashed" if tail else ""
+        out.append(f'    MC{s:02d} -> MC{t:02d} [label="{label}"{style}];')
     out.append("}")
     return "\n".join(out) + "\n"
