@@ -82,3 +82,14 @@ def _private_data_dir(tmp_path_factory, monkeypatch):
     """Backups and flash history go to a fresh folder, never the user's data directory."""
     monkeypatch.delenv("MERCMAC_DATA_DIR", raising=False)
     monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path_factory.mktemp("xdg-data")))
+
+
+def observed(record) -> dict:
+    """What a simulation run recorded, as plain data to compare two runs (fast-forward on/off)."""
+    return {
+        "reports": [(r.t, r.text) for r in record.reports],
+        "outputs": [(o.t, o.pattern) for o in record.outputs],
+        "dropped": (record.dropped["reports"], record.dropped["outputs"]),
+        "hazards": [(h.t, h.rule, h.where) for h in record.hazards],
+        "ended": record.ended_at,
+    }

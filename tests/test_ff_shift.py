@@ -11,7 +11,7 @@ from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import program_of
+from conftest import observed, program_of
 from mercmac.compiler.program import Macro, Op, Program
 from mercmac.timespec import Press
 from mercmac.vm import events as ev
@@ -38,14 +38,7 @@ def states(program: Program, mode: str, checkpoints: list[int], presses=(), opti
         m = machine
         seen.append((m.clock.now, m.position(), m.target, m.velocity(), m.moving(), m.macro,
                      m.ip, m.counters, m.block, m.wake, m.error, m.outputs_pattern()))
-    return {
-        "reports": [(r.t, r.text) for r in record.reports],
-        "outputs": [(o.t, o.pattern) for o in record.outputs],
-        "dropped": (record.dropped["reports"], record.dropped["outputs"]),
-        "hazards": [(h.t, h.rule, h.where) for h in record.hazards],
-        "ended": record.ended_at,
-        "states": seen,
-    }, record
+    return {**observed(record), "states": seen}, record
 
 
 def skips(record) -> list[ev.FastForwarded]:

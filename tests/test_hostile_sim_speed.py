@@ -18,7 +18,7 @@ from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import program_of
+from conftest import observed, program_of
 from mercmac.cli import main
 from mercmac.compiler.program import Macro, Op, Program
 from mercmac.outfile import OutputError
@@ -173,11 +173,7 @@ def outcome(program: Program, buttons: list, until_ms: int, mode: str):
     machine.run_until(until_ms)
     m = machine
     return {
-        "reports": [(r.t, r.text) for r in record.reports],
-        "outputs": [(o.t, o.pattern) for o in record.outputs],
-        "dropped": (record.dropped["reports"], record.dropped["outputs"]),
-        "hazards": [(h.t, h.rule, h.where) for h in record.hazards],
-        "ended": record.ended_at,
+        **observed(record),
         "final": (m.clock.now, m.macro, m.ip, m.ret and (m.ret[0].slot, m.ret[1]), m.counters,
                   m.last_rp, m.outputs_pattern(), m.position(), m.block, m.wake, m.error),
     }
