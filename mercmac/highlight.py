@@ -28,8 +28,6 @@ DURATION = r"[0-9]+(?:\.[0-9]+)?[ \t]*(?i:ms|min|s|h|d)(?![A-Za-z0-9_])"
 RAW_HEADER = r"\[[ \t]*(?i:MC)[ \t]*[+-]?[ \t]*[0-9]+[ \t]*\]"
 MODEL = r"(?i:C-?[0-9]{3})"
 COMMENT = r"//[^\r\n]*"
-DECLARATIONS = ("target", "const", "macro", "autostart")
-STATEMENTS = ("call", "goto", "when", "repeat", "every")
 
 
 def _command(lexer, match):

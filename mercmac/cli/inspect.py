@@ -11,18 +11,14 @@ from dataclasses import dataclass
 
 import click
 
-from mercmac.cli.common import FiniteFloat, run_guarded
+from mercmac.cli.common import run_guarded
+from mercmac.cli.upload import _ADDRESS, _BAUD, _TIMEOUT, _timing
 from mercmac.errors import EXIT_FAILED, EXIT_OK, UsageError
 
 _SOURCE = [
     click.argument("file", required=False, type=click.Path(dir_okay=False, allow_dash=True)),
     click.option("--port", help="Read the controller on this port instead of a file."),
-    click.option("--address", type=click.IntRange(0, 15), default=0, show_default=True,
-                 help="Controller address, DIP switches 1-4 (with --port)."),
-    click.option("--baud", type=click.IntRange(300, 921_600), default=9600, show_default=True,
-                 help="Baud rate, DIP switches 5-6 (with --port)."),
-    click.option("--timeout", type=FiniteFloat(0.05, 60), default=1.0, show_default=True,
-                 help="Seconds to wait for each reply (with --port)."),
+    _ADDRESS, _BAUD, _TIMEOUT,  # the uploader's own options, used with --port
 ]
 
 
@@ -56,10 +52,8 @@ def _read(file: str | None, port: str | None, address: int, baud: int, timeout: 
     if file is not None:
         return _read_file(file)
     from mercmac.upload import connect, survey
-    from mercmac.upload.transport import Timing
 
-    timing = Timing(timeout=timeout, settle=min(0.25, timeout))
-    with connect.open_controller(port, address, baud=baud, timing=timing) as c:
+    with connect.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
         pulled = survey.pull(c)
     return Macros(pulled.macros, pulled.identity.version.model, f"{port}, address {address}",
                   port, address)
@@ -126,7 +120,8 @@ def decompile(file, port, address, baud, timeout, output) -> None:
     FILE is a .mcm file of `[MCnn]` blocks (a pull, a backup); --port reads the
     controller instead. A controller or file that holds exactly a program
     `mercmac flash` wrote gives back that source, with its names and comments.
-    Exit 1 when FILE has errors, 2 when it cannot be read or nothing answers.
+    Exit 1 when FILE has errors or nothing answers, 2 when FILE or the port cannot
+    be opened.
     """
     def work() -> int:
         read = _read(file, port, address, baud, timeout)
@@ -196,7 +191,8 @@ def _write_graph(dot: str, path: str, kind: str) -> None:
         drawn = subprocess.run([shutil.which("dot") or "dot", "-Tsvg"], input=dot.encode(),
                                capture_output=True, timeout=60, check=False)
     except (OSError, subprocess.SubprocessError) as e:
-        raise UsageError(f"Graphviz's `dot` could not draw the call graph: {e}") from None
+        raise UsageError(f"Graphviz's `dot` could not draw the call graph: {outfile.reason(e)}") \
+            from None
     if drawn.returncode != 0:
         said = drawn.stderr.decode(errors="replace").strip()[:300]
         raise UsageError(f"Graphviz's `dot` could not draw the call graph: {said}")

@@ -41,7 +41,7 @@ def _port(port: str | None, option: str | None, command: str) -> str:
 def _timing(timeout: float):
     from mercmac.upload.transport import Timing
 
-    return Timing(timeout=timeout, settle=min(0.25, timeout))
+    return Timing.waiting(timeout)
 
 
 @click.command()
@@ -304,7 +304,7 @@ def emulate(target, address, state, firmware, tm_framing, empty_slot, log_file, 
 
         from mercmac.emulator.virtual import Faults, VirtualController
         from mercmac.emulator.ptyserver import PtyServer
-        from mercmac.outfile import appending
+        from mercmac.outfile import appending, reason
 
         faults = Faults(tm_framing=tm_framing, empty_slot=empty_slot, pace=pace, baud=baud)
         vc = VirtualController(target.upper(), address, firmware=firmware,
@@ -314,7 +314,7 @@ def emulate(target, address, state, firmware, tm_framing, empty_slot, log_file, 
             try:
                 server = PtyServer(vc, log)
             except OSError as e:
-                raise UsageError(f"cannot create a pseudo-terminal: {e}") from None
+                raise UsageError(f"cannot create a pseudo-terminal: {reason(e)}") from None
             kept = f", macros kept in {state}" if state else ""
             paced = f", paced at {baud} baud" if pace else ""
             logged = f", bytes logged to {log_file}" if log_file else ""

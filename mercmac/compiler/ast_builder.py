@@ -4,7 +4,7 @@ from __future__ import annotations
 from mercmac import mdtext
 from mercmac.compiler import ast
 from mercmac.compiler.parser_tables import Token, Transformer, v_args
-from mercmac.compiler.parse import BROKEN
+from mercmac.compiler.parse import BROKEN, paused_gc
 from mercmac.source import Span
 
 
@@ -136,7 +136,5 @@ _BUILDER = _Build()
 
 def build(tree) -> ast.Module:
     """The AST of a parse tree."""
-    from mercmac.compiler.parse import paused_gc
-
     with paused_gc():
         return _BUILDER.transform(tree)

@@ -9,11 +9,11 @@ from mercmac import mdtext
 from mercmac.commands import MODELS, Arg, lookup
 from mercmac.compiler import ast
 from mercmac.compiler.parse import BROKEN, nearest_keyword
-from mercmac.compiler.program import MAX_WA, MAX_WAITS, SLOTS, Op, rp_counts
+from mercmac.compiler.program import MAX_RP, MAX_WA, MAX_WAITS, SLOTS, Op, rp_counts
 from mercmac.diagnostics import Report
 from mercmac.source import Span
 
-MAX_REPEAT = 32_568 + 1  # `repeat N` lowers to RP N-1; MS176E §6.4 RP: n <= 32568
+MAX_REPEAT = MAX_RP + 1  # `repeat N` lowers to RP N-1; MS176E §6.4 RP: n <= 32568
 MAX_PERIOD_MS = MAX_WA * MAX_WAITS  # `every T` lowers to WA T, several WAs past 65535 ms
 INPUTS = range(1, 7)  # XN/XF: 1-4 inputs, 5 joystick, 6 joystick button (§6.4 XN)
 
@@ -110,9 +110,8 @@ def _block(body: tuple, env: Env, report: Report) -> None:
             _loop_goto(stmt, "repeat", report)
             _block(stmt.body, env, report)
         elif isinstance(stmt, ast.Every):
-            _bounded(stmt.period, env, report, range(0, MAX_PERIOD_MS + 1), "every",
-                     max=MAX_PERIOD_MS, wa=MAX_WA)
-            if _resolve(stmt.period, env, Report(report.file)) == 0:  # already range-checked
+            if _bounded(stmt.period, env, report, range(0, MAX_PERIOD_MS + 1), "every",
+                        max=MAX_PERIOD_MS, wa=MAX_WA) == 0:
                 report.add("every-zero", stmt.span)
             _loop_goto(stmt, "every", report)
             _block(stmt.body, env, report)
@@ -184,11 +183,13 @@ def _edits(a: str, b: str) -> int:
 
 
 def _bounded(value: ast.Value, env: Env, report: Report, allowed: range, what: str,
-             **values) -> None:
-    """Report a `when` input or an `every` period outside `allowed` (message variant `what`)."""
+             **values) -> int | None:
+    """Report a `when` input or an `every` period outside `allowed` (message variant `what`);
+    the number, or None when it has none."""
     number = _resolve(value, env, report)
     if number is not None and number not in allowed:
         report.add("argument-range", value.span, what, number=number, **values)
+    return number
 
 
 def _resolve(value: ast.Value, env: Env, report: Report) -> int | None:

@@ -125,8 +125,9 @@ def parse_partial(text: str, report: Report) -> Parsed:
     """
     nul = text.find("\x00")
     if nul >= 0:
-        report.add("syntax", _span_at(text, nul), "binary")
-        return Parsed(None, frozenset({_span_at(text, nul).line}), True)
+        span = _span_at(text, nul)
+        report.add("syntax", span, "binary")
+        return Parsed(None, frozenset({span.line}), True)
     recovery = _Recovery(report, text)
     _ACTIVE.append(recovery)
     try:

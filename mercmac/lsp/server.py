@@ -246,10 +246,6 @@ def document_symbols(ls: MercmacServer, params: t.DocumentSymbolParams) -> list[
 def formatting(ls: MercmacServer, params: t.DocumentFormattingParams) -> list[t.TextEdit] | None:
     """The whole document as `mercmac fmt` writes it (one edit), or no edit."""
     format_text = formatter()
-    if format_text is None:
-        ls.window_show_message(t.ShowMessageParams(
-            type=t.MessageType.Warning, message="mercmac: no formatter in this version"))
-        return None
     document = ls.workspace.get_text_document(params.text_document.uri)
     text = document.source
     try:
@@ -264,15 +260,10 @@ def formatting(ls: MercmacServer, params: t.DocumentFormattingParams) -> list[t.
 
 
 def formatter():
-    """`format_text(text) -> str` of `mercmac fmt`, or None where it does not exist."""
-    import importlib
+    """`format_text(text) -> str` of `mercmac fmt`."""
+    from mercmac.fmt import format_text
 
-    for module in ("mercmac.fmt", "mercmac.compiler.fmt"):
-        try:
-            return importlib.import_module(module).format_text
-        except (ImportError, AttributeError):
-            continue
-    return None
+    return format_text
 
 
 @server.feature(t.TEXT_DOCUMENT_CODE_ACTION,

@@ -10,11 +10,10 @@ from typing import NamedTuple
 
 from mercmac.commands import COMMANDS, lookup
 from mercmac.compiler import ast
+from mercmac.compiler.parse import KEYWORDS  # noqa: F401  (completion and rename use them)
 from mercmac.compiler.program import Program
 from mercmac.source import Source, Span
 
-KEYWORDS = ("macro", "autostart", "const", "target", "when", "and", "not", "repeat", "every",
-            "call", "goto")
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.]*\Z")
 _DEFINES = {ast.MacroDef: re.compile(r"macro\s+([A-Za-z_][A-Za-z0-9_.]*)"),
             ast.Const: re.compile(r"const\s+([A-Za-z_][A-Za-z0-9_.]*)")}

@@ -154,8 +154,6 @@ def write_errors(result, stream: IO[str] | None = None) -> bool:
 def write_warnings(result, stream: IO[str] | None = None) -> None:
     """Show a compilation's warnings on stderr (infos stay with `check`); `build` and
     `flash` go on: a warning is worth reading, not a reason to refuse."""
-    from mercmac.diagnostics import Severity
-
     warnings = [d for d in result.report.items if d.severity is Severity.WARNING]
     if warnings:
         write_text(warnings, {result.source.name: result.source}, 1, stream or sys.stderr,

@@ -301,7 +301,7 @@ def to_json(run: Run) -> str:
     return json.dumps(out, indent=2)
 
 
-JSON_CAP = 10_000  # SPEC §5: each JSON list keeps its first 10,000 entries
+JSON_CAP = record.CAP  # SPEC §5: each JSON list keeps its first 10,000 entries
 
 
 def _truncated(rec: Recorder) -> dict:

@@ -6,6 +6,7 @@
     scenario.py    TOML scenarios: timed steps and expectations
     interactive.py the keyboard as a C-170.PB pushbutton box
     vcd.py         Value Change Dump output
+    plot.py        the --plot picture (matplotlib, imported only when drawing)
 
 Rendering lives in `mercmac.render.sim`; the VM itself in `mercmac.vm`.
 """

@@ -170,7 +170,7 @@ def _last_pattern(shape: tuple) -> int | None:
     for item in shape:
         if item[0] == ff.OUTPUTS:
             last = item[2]  # (OUTPUTS, offset, pattern)
-        elif item[0] == ff.SKIP:
+        elif item[0] in (ff.SKIP, ff.SHIFTED):  # an inner skip, shifted or not
             inner = _last_pattern(item[4])
             last = last if inner is None else inner
     return last

@@ -107,7 +107,7 @@ class VcdObserver:
                 self.last = last + item[1]
                 for i, var in enumerate(self.outputs):
                     self.writer.change(var, self.last, item[2] >> i & 1)
-            elif item[0] == ff.SKIP:
+            elif item[0] in (ff.SKIP, ff.SHIFTED):  # an inner skip, shifted or not
                 self._stretch(last + item[1], item[2], item[3], item[4])
 
     def _sample(self, until: int) -> None:

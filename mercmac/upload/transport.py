@@ -53,6 +53,11 @@ class Timing:
                 raise ValueError(f"{name} must be a positive number of seconds, "
                                  f"not {getattr(self, name)!r}")
 
+    @classmethod
+    def waiting(cls, timeout: float) -> "Timing":
+        """The timing for a `--timeout` option: a listing settles within the reply timeout."""
+        return cls(timeout=timeout, settle=min(0.25, timeout))
+
     def budget(self, baud: int, size: int = LONGEST_REPLY) -> float:
         """Longest time one exchange may take: a timeout plus `size` bytes at `baud`."""
         return self.timeout + size * 10 / max(baud, 300) + 2.0
