@@ -9,20 +9,28 @@ found upward from the file being checked (SPEC §5).
 In one folder mercmac.toml wins over pyproject.toml; a pyproject.toml without a
 `[tool.mercmac]` table is passed over (as ruff does). Command-line options override
 these settings key by key.
+
+A settings file is UTF-8 TOML. A leading UTF-8 byte-order mark is read past, as ruff and
+Cargo read one (Windows editors write it; TOML 1.0 does not forbid it, tomllib alone
+refuses it). Only a regular file is read, and at most mercmac.source.MAX_BYTES of it: a
+FIFO or a link to /dev/zero is named, not waited on (issue 20). Whatever is wrong with
+a settings file stops `check` with a message naming the file (exit 2).
 """
 from __future__ import annotations
 
 import os
-import re
+import reprlib
 from typing import NamedTuple
 
 from mercmac.commands import MODELS
 from mercmac.errors import UsageError
 
 KEYS = ("target", "select", "ignore")
-# Only a pyproject.toml that has the table is parsed: the others cost one read and no
-# TOML import (`check` stays quick to start, benchmarks/check_latency.py).
-_TABLE = re.compile(r"^[ \t]*\[[ \t]*tool[ \t]*\.[ \t]*mercmac[ \t]*\]", re.MULTILINE)
+# Only a pyproject.toml that names mercmac is parsed: the others cost one read and no TOML
+# import (`check` stays quick to start, benchmarks/check_latency.py). Any mention, not just
+# a `[tool.mercmac]` line: the table may be written `tool = {mercmac = {...}}` or
+# `[tool]` with `mercmac.select = [...]`, and is the same table in each spelling.
+_MENTION = "mercmac"
 
 
 class Settings(NamedTuple):
@@ -55,26 +63,71 @@ def _settings_in(folder: str) -> Settings:
 
 
 def _read_folder(folder: str) -> Settings | None:
-    """The settings of this folder's mercmac.toml or pyproject.toml; None if it has neither."""
+    """The settings of this folder's mercmac.toml or pyproject.toml; None if it has neither.
+    (lexists: whatever stands there under the name is read or named, a FIFO or a broken
+    link too, rather than passed over in silence.)"""
     own = os.path.join(folder, "mercmac.toml")
-    if os.path.isfile(own):
-        return _parse(own, _load(own, _read(own)))
+    if os.path.lexists(own):
+        table = _load(own, _read(own))
+        if isinstance(table.get("tool"), dict) and "mercmac" in table["tool"]:
+            raise UsageError(f"[tool.mercmac] in {own}: a mercmac.toml holds the "
+                             "settings at its top level", hint="remove the [tool.mercmac] line")
+        return _parse(own, table)
     project = os.path.join(folder, "pyproject.toml")
-    if os.path.isfile(project):
+    if os.path.lexists(project):
         text = _read(project)
-        if _TABLE.search(text):
-            table = _load(project, text).get("tool", {}).get("mercmac")
-            if isinstance(table, dict):
-                return _parse(project, table, "[tool.mercmac] of ")
+        if _MENTION in text:
+            return _project_settings(project, _load(project, text))
     return None
 
 
+def _project_settings(path: str, document: dict) -> Settings | None:
+    """The settings in a pyproject.toml's `[tool.mercmac]`, in any TOML spelling; None
+    without the table. `[[tool.mercmac]]` (a list of tables) is refused, not guessed at."""
+    tool = _table(document.get("tool", {}), "tool", path)
+    table = tool.get("mercmac")
+    if table is None:
+        return None
+    if isinstance(table, list):
+        raise UsageError(f"[[tool.mercmac]] in {path} is an array of tables: mercmac "
+                         "reads one table", hint="write [tool.mercmac] with single brackets")
+    return _parse(path, _table(table, "tool.mercmac", path), "[tool.mercmac] of ")
+
+
+def _table(value, key: str, path: str) -> dict:
+    """VALUE, when it is a TOML table; else the usage error that says what it is."""
+    if not isinstance(value, dict):
+        raise UsageError(f"{key} in {path} is {_toml_type(value)}, not a table")
+    return value
+
+
+def _toml_type(value) -> str:
+    """'a string', 'an array', ... as TOML names the type of a value."""
+    names = {str: "a string", bool: "a boolean", int: "an integer", float: "a float",
+             list: "an array", dict: "a table"}
+    return names.get(type(value), "a date or time")
+
+
 def _read(path: str) -> str:
+    """A settings file's text: a regular file, capped (mercmac.source.read_bytes), UTF-8."""
+    from mercmac.outfile import reason
+    from mercmac.source import read_bytes
+
     try:
-        with open(path, encoding="utf-8") as f:
-            return f.read()
-    except (OSError, UnicodeDecodeError) as e:
-        raise UsageError(f"cannot read the settings in {path}: {e}") from None
+        data = read_bytes(path)
+    except OSError as e:
+        raise UsageError(f"cannot read the settings in {path}: {reason(e)}") from None
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise UsageError(f"cannot read the settings in {path}: it starts with a "
+                         "UTF-16 byte-order mark, and TOML files are UTF-8",
+                         hint="save it as UTF-8")
+    try:
+        return data.decode("utf-8-sig")  # a leading UTF-8 BOM is read past (module docstring)
+    except UnicodeDecodeError as e:
+        line = data[:e.start].count(b"\n") + 1
+        raise UsageError(f"cannot read the settings in {path}: byte "
+                         f"0x{data[e.start]:02X} at line {line} is not UTF-8, and TOML files "
+                         "are UTF-8", hint="save it as UTF-8") from None
 
 
 def _load(path: str, text: str) -> dict:
@@ -86,19 +139,23 @@ def _load(path: str, text: str) -> dict:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise UsageError(f"{path} is not valid TOML: {e}") from None
+    except RecursionError:  # tomllib reads nested arrays and tables by recursion
+        raise UsageError(f"{path} is not valid settings: its arrays or tables are "
+                         "nested too deeply to read") from None
 
 
 def _parse(path: str, table: dict, where: str = "") -> Settings:
     """Settings from a table, refusing what `check` would not understand (exit 2)."""
     unknown = sorted(set(table) - set(KEYS))
     if unknown:
+        keys = ", ".join(reprlib.repr(k) for k in unknown[:5]) + (", ..." if unknown[5:] else "")
         raise UsageError(f"unknown setting{'s' if len(unknown) > 1 else ''} "
-                         f"{', '.join(map(repr, unknown))} in {where}{path}",
+                         f"{keys} in {where}{path}",
                          hint=f"mercmac knows {', '.join(KEYS)}")
     target = table.get("target")
     if target is not None and (not isinstance(target, str) or target.upper() not in MODELS):
-        raise UsageError(f"target = {target!r} in {where}{path} is not a model: use "
-                         f"{' or '.join(MODELS)}")
+        raise UsageError(f"target = {reprlib.repr(target)} in {where}{path} is not a model: "
+                         f"use {' or '.join(MODELS)}")
     return Settings(path, target.upper() if target else None,
                     _rule_list(table, "select", path, where),
                     _rule_list(table, "ignore", path, where))

@@ -300,6 +300,21 @@ simulator reports it as a busy-loop hazard. Give the loop a period of a few ms
 (`every 20ms`), which adds a WA to each pass.""", {
         "": "every 0ms waits nothing between passes: a busy loop at the full command rate; "
             "poll every few ms instead (every 20ms)"}),
+    Rule("MM034", "invalid-suppression", _W, "a `// mercmac: ignore[...]` comment that cannot be read", """\
+`// mercmac: ignore[RULE, ...]` turns the named rules off on its own line, and
+`// mercmac: ignore` every rule (codes and names in any case). A comment whose
+bracket is never closed, that names a rule mercmac does not have, or that names
+none, turns nothing off - rather than guess, which could hide an error - and
+`check` says so here, as ruff reports a `# noqa` with an unknown code (RUF102).
+Close the bracket, fix the spelling (`mercmac explain` lists the rules), or
+remove the comment. Only `check` reads these comments.""", {
+        "unclosed": "this `mercmac: ignore[` has no closing `]`, so it turns nothing off: "
+                    "write `// mercmac: ignore[RULE, ...]`",
+        "unknown": "no rule {key}: this comment does not turn it off (`mercmac explain` "
+                   "lists the codes and names)",
+        "empty": "`mercmac: ignore[]` names no rule, so it turns nothing off: name the rules, "
+                 "or write `// mercmac: ignore` for every rule on the line",
+    }),
 )
 
 _BY_KEY = {r.code: r for r in RULES} | {r.name: r for r in RULES}

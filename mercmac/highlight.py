@@ -19,6 +19,7 @@ from pygments.token import (Comment, Error, Keyword, Name, Number, Operator, Pun
 
 from mercmac import mdtext
 from mercmac.commands import COMMANDS, lookup
+from mercmac.source import LINE_END
 
 # The tokens of grammar.lark, as regular expressions both Pygments and Oniguruma read.
 NAME = r"[A-Za-z_][A-Za-z0-9_.]*"
@@ -87,7 +88,7 @@ class McmLexer(RegexLexer):
     tokens = {
         "root": [
             (r"[ \t\f]+", Whitespace),
-            (r"\r?\n", Whitespace),
+            (LINE_END.pattern, Whitespace),  # LF, CRLF or a lone CR: mercmac.source
             (COMMENT, Comment.Single),
             (rf"({RAW_HEADER})([^\r\n]*)", _raw_line),
             (rf"(target)([ \t]+)({MODEL})\b", bygroups(Keyword.Declaration, Whitespace,

@@ -1,10 +1,24 @@
 """Writing the user's files: the whole new file or the old one, and only where a file belongs.
 
 Every file mercmac writes (build output, backups, pulled programs, VCD dumps,
-the emulator's state) goes through here. The text goes to a temporary file in
+the emulator's state, `fmt`) goes through here. The text goes to a temporary file in
 the same folder, is flushed to disk, and replaces the old file only when it is
-complete; on any failure, Ctrl-C included, the temporary file is removed and
-the old file is untouched.
+complete; on any failure, Ctrl-C and SIGTERM included, the temporary file is removed
+and the old file is untouched.
+
+A file with more than one name (hard links) is written in place instead, so that every
+name sees the new text (issue 20): the new bytes are complete on disk first, the old
+bytes are copied beside the file, the space is reserved, and only then is the file
+overwritten and cut to length, with Ctrl-C and SIGTERM held off. If that fails (an I/O
+error) the old bytes are written back; if even that fails, or the machine stops midway,
+the copy beside the file (`.mercmac-*.tmp`) holds the old text, and the error names it.
+
+A read-only file (no write permission bit, as an editor sees it, even for root) is
+refused. A caller that read the file first may pass what it read (`Snapshot`): the
+file is then replaced only if it still holds exactly that (size, modification time and
+SHA-256), so that an edit another program saved meanwhile is not lost. The comparison
+and the replacement are two steps (no file system offers a compare-and-swap of a file):
+only an edit saved in the microseconds between them would go unseen.
 
 Paths are taken deliberately: a symlink is followed (its target is rewritten,
 the link stays), an existing file keeps its permission bits, and anything that
@@ -15,11 +29,15 @@ regular file.
 from __future__ import annotations
 
 import contextlib
+import errno
+import hashlib
 import os
+import signal
 import stat
 import tempfile
+import threading
 from pathlib import Path
-from typing import IO, Iterator
+from typing import IO, Iterator, NamedTuple
 
 from mercmac.errors import UsageError
 
@@ -39,6 +57,25 @@ class OutputError(UsageError):
     """A file that cannot or must not be written; exit code 2, nothing changed."""
 
 
+def kind(mode: int) -> str:
+    """What a file of this st_mode is, in words: 'a FIFO (named pipe)', 'a folder', ..."""
+    return next((name for test, name in _KINDS if test(mode)), "not a regular file")
+
+
+class Snapshot(NamedTuple):
+    """What a file held when it was read: its size, modification time and SHA-256."""
+
+    size: int
+    mtime_ns: int
+    digest: bytes
+
+
+def snapshot(path: str | os.PathLike, data: bytes) -> Snapshot:
+    """The snapshot of PATH, just read as DATA (stat after the read: a change in between
+    shows as a size or a digest that does not match)."""
+    return Snapshot(len(data), os.stat(path).st_mtime_ns, hashlib.sha256(data).digest())
+
+
 def writable_target(path: str | os.PathLike, *, make_parents: bool = False) -> Path:
     """The regular file that writing PATH will replace (symlinks followed), or OutputError.
 
@@ -46,7 +83,7 @@ def writable_target(path: str | os.PathLike, *, make_parents: bool = False) -> P
     not be written (a flash writes its backup before touching the controller).
     """
     given = Path(path)
-    target = Path(os.path.realpath(given)) if given.is_symlink() else given
+    target = _followed(given)
     try:
         st = target.stat()
     except FileNotFoundError:
@@ -54,9 +91,11 @@ def writable_target(path: str | os.PathLike, *, make_parents: bool = False) -> P
     except OSError as e:
         raise OutputError(f"cannot write {given}: {reason(e)}") from None
     if st is not None and not stat.S_ISREG(st.st_mode):
-        kind = next((name for test, name in _KINDS if test(st.st_mode)), "not a regular file")
-        raise OutputError(f"cannot write {given}: it is {kind}, not a regular file",
+        raise OutputError(f"cannot write {given}: it is {kind(st.st_mode)}, not a regular file",
                           hint="give the path of a file to create or replace")
+    if st is not None and _read_only(target, st):
+        raise OutputError(f"cannot write {given}: it is read-only",
+                          hint="make it writable (chmod u+w) if it is meant to change")
     folder = target.parent
     if make_parents:
         try:
@@ -71,45 +110,208 @@ def writable_target(path: str | os.PathLike, *, make_parents: bool = False) -> P
     return target
 
 
+def _followed(given: Path) -> Path:
+    """The file a path names: a symlink's target (which is rewritten; the link stays)."""
+    return Path(os.path.realpath(given)) if given.is_symlink() else given
+
+
+def _read_only(target: Path, st: os.stat_result) -> bool:
+    """As an editor sees it: no write permission bit at all (root may write anything, but a
+    0444 file says it is not meant to change), or not writable by this user."""
+    return not st.st_mode & 0o222 or not os.access(target, os.W_OK)
+
+
 @contextlib.contextmanager
 def replacing(path: str | os.PathLike, *, binary: bool = False, encoding: str = "utf-8",
-              make_parents: bool = False, durable: bool = True) -> Iterator[IO]:
-    """A file object on a temporary file that replaces PATH when the block ends normally."""
+              make_parents: bool = False, durable: bool = True,
+              expect: Snapshot | None = None) -> Iterator[IO]:
+    """A file object on a temporary file that replaces PATH when the block ends normally
+    (in place when PATH has hard links); with EXPECT, only if PATH still holds that."""
     target = writable_target(path, make_parents=make_parents)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=TEMP_SUFFIX, dir=target.parent)
-    except OSError as e:
-        raise OutputError(f"cannot write {path}: {reason(e)}") from None
-    try:
-        mode = "wb" if binary else "w"
+    with _terminable(path):
         try:
-            f = os.fdopen(fd, mode, **({} if binary else {"encoding": encoding, "newline": "\n"}))
+            fd, tmp = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=TEMP_SUFFIX, dir=target.parent)
+        except OSError as e:
+            raise OutputError(f"cannot write {path}: {reason(e)}") from None
+        try:
+            mode = "wb" if binary else "w"
+            try:
+                text = {} if binary else {"encoding": encoding, "newline": "\n"}
+                f = os.fdopen(fd, mode, **text)
+            except BaseException:
+                os.close(fd)
+                raise
+            with f:
+                yield f
+                f.flush()
+                if durable:
+                    os.fsync(f.fileno())
+            _unchanged(target, expect, path)
+            _put(tmp, target, path)
+        except OSError as e:
+            _remove(tmp)
+            raise OutputError(f"cannot write {path}: {reason(e)}") from None
         except BaseException:
-            os.close(fd)
+            _remove(tmp)
             raise
-        with f:
-            yield f
-            f.flush()
-            if durable:
-                os.fsync(f.fileno())
-        _copy_mode(target, tmp)
-        os.replace(tmp, target)
-    except OSError as e:
-        _remove(tmp)
-        raise OutputError(f"cannot write {path}: {reason(e)}") from None
-    except BaseException:
-        _remove(tmp)
-        raise
     if durable:
         _sync_folder(target.parent)
 
 
+def write_bytes(path: str | os.PathLike, data: bytes, *, make_parents: bool = False,
+                expect: Snapshot | None = None) -> Path:
+    """Write DATA to PATH whole or not at all; returns the file written."""
+    with replacing(path, binary=True, make_parents=make_parents, expect=expect) as f:
+        f.write(data)
+    return _followed(Path(path))
+
+
 def write_text(path: str | os.PathLike, text: str, *, encoding: str = "utf-8",
-               make_parents: bool = False) -> Path:
-    """Write TEXT to PATH whole or not at all; returns the file written."""
-    with replacing(path, encoding=encoding, make_parents=make_parents) as f:
-        f.write(text)
-    return writable_target(path)
+               make_parents: bool = False, expect: Snapshot | None = None) -> Path:
+    """Write TEXT to PATH whole or not at all (UnicodeEncodeError before anything is
+    written); returns the file written."""
+    return write_bytes(path, text.encode(encoding), make_parents=make_parents, expect=expect)
+
+
+def _unchanged(target: Path, expect: Snapshot | None, path) -> None:
+    """OutputError unless TARGET still holds what EXPECT says was read (issue 20: `fmt`
+    of a large file takes a while, and an editor may save meanwhile)."""
+    if expect is None:
+        return
+    try:
+        st = target.stat()
+        same = (st.st_size, st.st_mtime_ns) == expect[:2] and _digest(target) == expect.digest
+    except FileNotFoundError:
+        same = False
+    if not same:
+        raise OutputError(f"cannot write {path}: it changed after it was read (another "
+                          "program wrote to it); left as it is now",
+                          hint="run the command again")
+
+
+def _digest(path: Path) -> bytes:
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.digest()
+
+
+def _put(tmp: str, target: Path, path) -> None:
+    """The complete temporary file becomes TARGET: renamed over it, or copied into it in
+    place when TARGET has other names (hard links) that must see the new text too."""
+    try:
+        links = target.stat().st_nlink
+    except FileNotFoundError:
+        links = 1
+    if links > 1:
+        _overwrite(target, tmp, path)
+        _remove(tmp)
+        return
+    _copy_mode(target, tmp)
+    os.replace(tmp, target)
+
+
+def _overwrite(target: Path, new: str, path) -> None:
+    """Copy NEW over TARGET in place, whole or not at all (see the module's docstring)."""
+    with _held_signals():  # also while the copy is made and removed: none is left behind
+        keep = _copy_beside(target)
+        try:
+            _copy_into(new, target)
+        except BaseException as e:  # an I/O error, or a signal that another thread took
+            _restore(keep, target, path, e)
+            raise
+        _remove(keep)
+
+
+def _restore(keep: str, target: Path, path, cause: BaseException) -> None:
+    """Put the old bytes back after a failed in-place write; OutputError naming the copy
+    that holds them when even that fails."""
+    try:
+        _copy_into(keep, target)
+    except OSError:
+        raise OutputError(f"cannot write {path}: {reason(cause)}, and its old text could not "
+                          f"be put back: it is in {keep}",
+                          hint=f"copy {keep} over {path} when the disk works again") from None
+    _remove(keep)
+
+
+def _copy_beside(target: Path) -> str:
+    """A durable copy of TARGET's bytes in its folder: what a failed in-place write restores."""
+    fd, keep = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=TEMP_SUFFIX, dir=target.parent)
+    try:
+        with os.fdopen(fd, "wb") as out, open(target, "rb") as old:
+            for block in iter(lambda: old.read(1 << 20), b""):
+                out.write(block)
+            out.flush()
+            os.fsync(out.fileno())
+    except BaseException:
+        _remove(keep)
+        raise
+    return keep
+
+
+def _copy_into(source: str | Path, target: Path) -> None:
+    """SOURCE's bytes over TARGET's, same inode: space reserved first, cut to length last."""
+    with open(source, "rb") as src, open(target, "r+b") as out:
+        size = os.fstat(src.fileno()).st_size
+        if size and hasattr(os, "posix_fallocate"):
+            try:
+                os.posix_fallocate(out.fileno(), 0, size)  # ENOSPC here, before a byte changes
+            except OSError as e:
+                if e.errno not in (errno.EOPNOTSUPP, errno.EINVAL, errno.ENOSYS):
+                    raise
+        for block in iter(lambda: src.read(1 << 20), b""):
+            out.write(block)
+        out.flush()
+        os.ftruncate(out.fileno(), size)
+        os.fsync(out.fileno())
+
+
+@contextlib.contextmanager
+def _held_signals() -> Iterator[None]:
+    """Ctrl-C and SIGTERM wait while a file is overwritten in place (POSIX): the write
+    and, on an I/O error, the restore are never cut in half. They come right after."""
+    held = {signal.SIGINT, signal.SIGTERM}
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+
+
+class _Terminated(BaseException):
+    """SIGTERM during a write: unwinds it like Ctrl-C, so that the temporary file goes."""
+
+
+def _terminated(signum, frame) -> None:
+    raise _Terminated
+
+
+@contextlib.contextmanager
+def _terminable(path) -> Iterator[None]:
+    """While a file is written, SIGTERM raises _Terminated (main thread only, where Python
+    runs signal handlers), so that the cleanup runs; then the signal is delivered again
+    to the handler before (by default the process ends, killed by SIGTERM, as it would have)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.getsignal(signal.SIGTERM)
+    if previous in (signal.SIG_IGN, None):
+        yield
+        return
+    signal.signal(signal.SIGTERM, _terminated)
+    try:
+        yield
+    except _Terminated:
+        signal.signal(signal.SIGTERM, previous)
+        signal.raise_signal(signal.SIGTERM)
+        raise OutputError(f"cannot write {path}: stopped by SIGTERM") from None
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def appending(path: str | os.PathLike, *, encoding: str = "utf-8") -> IO[str]:
@@ -126,8 +328,7 @@ def appending(path: str | os.PathLike, *, encoding: str = "utf-8") -> IO[str]:
     try:
         mode = os.fstat(fd).st_mode
         if not stat.S_ISREG(mode):
-            kind = next((name for test, name in _KINDS if test(mode)), "not a regular file")
-            raise OutputError(f"cannot write {path}: it is {kind}, not a regular file",
+            raise OutputError(f"cannot write {path}: it is {kind(mode)}, not a regular file",
                               hint="give the path of a file to create or add to")
         if hasattr(os, "O_NONBLOCK"):
             os.set_blocking(fd, True)

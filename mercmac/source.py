@@ -1,7 +1,34 @@
 """Source text and positions: what every diagnostic and instruction points at."""
 from __future__ import annotations
 
+import errno
+import os
+import re
+import stat
+import sys
 from typing import NamedTuple
+
+from mercmac.errors import UsageError
+from mercmac.outfile import kind
+
+# The one definition of a line end in mercmac (SPEC §5): LF, CRLF or a lone CR, mixed freely,
+# as the LSP specification and editors count lines. Form feeds, vertical tabs, U+0085,
+# U+2028 and U+2029 end no line (str.splitlines would split there; editors do not).
+LINE_END = re.compile(r"\r\n|\r|\n")
+
+
+def split_lines(text: str, keepends: bool = False) -> list[str]:
+    """TEXT's lines without their ends; the last is what follows the last line end.
+    With KEEPENDS, each line with its end, as str.splitlines(keepends=True) gives them."""
+    if keepends:
+        ends = [m.end() for m in LINE_END.finditer(text)]
+        return [text[a:b] for a, b in zip([0, *ends], [*ends, len(text)]) if a < b]
+    return LINE_END.split(text) if "\r" in text else text.split("\n")
+
+
+def to_lf(text: str) -> str:
+    """TEXT with every line end written LF: the same lines and columns (what the parser reads)."""
+    return LINE_END.sub("\n", text) if "\r" in text else text
 
 
 class Span(NamedTuple):
@@ -29,37 +56,171 @@ class Source:
         return f"Source({self.name!r}, {len(self.text)} characters)"
 
     def line(self, number: int) -> str:
-        """Line `number` (1-based) as the parser counts lines: split at LF only."""
+        """Line `number` (1-based), without its end (LINE_END)."""
         if self._lines is None:  # split once: a diagnostic per line must not rescan the file
-            self._lines = self.text.split("\n")
+            self._lines = split_lines(self.text)
         lines = self._lines
-        return lines[number - 1].removesuffix("\r") if 0 < number <= len(lines) else ""
+        return lines[number - 1] if 0 < number <= len(lines) else ""
 
 
-# Byte-order marks, longest first: the UTF-32 LE mark begins with the UTF-16 LE one.
-_BOMS = ((b"\xff\xfe\x00\x00", "utf-32-le"), (b"\x00\x00\xfe\xff", "utf-32-be"),
-         (b"\xef\xbb\xbf", "utf-8"), (b"\xff\xfe", "utf-16-le"), (b"\xfe\xff", "utf-16-be"))
+# -- reading a file's bytes ----------------------------------------------------------------------
+
+# The largest .mcm file read: 32 macros of 16 commands fit in a few kB, and the largest file a
+# person keeps (comments, names, rigs) in well under a MB; the cap stops a device such as
+# /dev/zero, or a wrong file, from filling the memory (issue 20).
+MAX_BYTES = 16 * 1024 * 1024
 
 
-def decode(data: bytes) -> str:
-    """Text of a .mcm file: UTF-8, else Windows-1252; UTF-16/32 when a BOM or the NULs say so.
+class SourceError(OSError):
+    """A file mercmac does not read: not a regular file, or too large. An OSError, so that
+    every `cannot read FILE: reason` place words it (`reason` reads `strerror`)."""
+
+    def __init__(self, path: str, why: str):
+        super().__init__(errno.EINVAL, why, path)
+
+
+def read_bytes(path: str) -> bytes:
+    """The bytes of a .mcm file ('-': standard input): a regular file only, at most MAX_BYTES.
+
+    The file is opened without blocking (O_NONBLOCK), so that opening a FIFO with no writer
+    cannot hang, and its kind is taken from what was opened (fstat), not from the name.
+    """
+    if path == "-":
+        if sys.stdin is None:  # started with standard input closed (`<&-`)
+            raise SourceError("-", "standard input is closed")
+        return _capped(sys.stdin.buffer, "standard input")
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
+                 | getattr(os, "O_BINARY", 0))
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise SourceError(path, f"it is {kind(st.st_mode)}, not a regular file")
+        if st.st_size > MAX_BYTES:
+            raise SourceError(path, _too_large(st.st_size))
+        if hasattr(os, "O_NONBLOCK"):
+            os.set_blocking(fd, True)
+        f = open(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+    with f:
+        return _capped(f, path)
+
+
+def _capped(f, name: str) -> bytes:
+    """All of F, or SourceError once it holds more than MAX_BYTES (a file may grow, and
+    standard input or a /proc file says no size beforehand)."""
+    data = f.read(MAX_BYTES + 1)
+    if len(data) > MAX_BYTES:
+        raise SourceError(name, _too_large(None))
+    return data
+
+
+def _too_large(size: int | None) -> str:
+    """'it is 20.5 MB: larger than mercmac reads (16 MB)'."""
+    cap = f"mercmac reads ({MAX_BYTES // 2**20} MB)"
+    if size is None:
+        return f"it holds more than {cap}"
+    return f"it is {size / 2**20:.1f} MB: larger than {cap}"
+
+
+def read_source(path: str) -> Source:
+    """Read a file (or '-' for standard input); OSError (SourceError included) propagates."""
+    return Source("<stdin>" if path == "-" else path, decode(read_bytes(path)))
+
+
+# -- bytes to text --------------------------------------------------------------------------------
+
+class Encoding(str):
+    """The codec a file was read with (a str, as `bytes.decode` takes it) and the byte-order
+    mark it begins with: `write` gives back a text's bytes in the file's own encoding."""
+
+    bom: bytes
+
+    def __new__(cls, codec: str, bom: bytes = b"") -> Encoding:
+        self = super().__new__(cls, codec)
+        self.bom = bom
+        return self
+
+    def write(self, text: str) -> bytes:
+        """TEXT as the file holds it: the BOM, then the text in the codec (strict)."""
+        return self.bom + text.encode(self)
+
+    def read(self, data: bytes, errors: str = "strict") -> str:
+        """The text of DATA, its BOM left out."""
+        return data[len(self.bom):].decode(self, errors)
+
+
+class EncodingError(UsageError):
+    """Bytes that do not read in the file's encoding: writing the text back would change them."""
+
+
+# Byte-order marks, longest first: the UTF-32 LE mark begins with the UTF-16 LE one. The
+# UTF-8 mark is left to Python's utf-8-sig codec, which reads and writes it.
+_BOMS = ((b"\xff\xfe\x00\x00", Encoding("utf-32-le", b"\xff\xfe\x00\x00")),
+         (b"\x00\x00\xfe\xff", Encoding("utf-32-be", b"\x00\x00\xfe\xff")),
+         (b"\xef\xbb\xbf", Encoding("utf-8-sig")),
+         (b"\xff\xfe", Encoding("utf-16-le", b"\xff\xfe")),
+         (b"\xfe\xff", Encoding("utf-16-be", b"\xfe\xff")))
+
+
+def encoding_of(data: bytes) -> Encoding:
+    """A .mcm file's encoding: UTF-8, else Windows-1252; UTF-16/32 when a BOM or the NULs
+    say so.
 
     MMCRun is a Windows program and writes the '(TM)' sign of its header
     comment (MS176E §3.8.6, Example 4) as the single byte 0x99. Notepad may
     save "Unicode" (UTF-16 LE with a BOM). Whatever is left with NUL
     characters is not text; the parser says so.
     """
-    for bom, codec in _BOMS:
+    for bom, encoding in _BOMS:
         if data.startswith(bom):
-            return data[len(bom):].decode(codec, errors="replace")
+            return encoding
     if b"\x00" in data[:4096]:
         codec = _utf16_without_bom(data[:4096])
         if codec:
-            return data.decode(codec, errors="replace")
+            return Encoding(codec)
     try:
-        return data.decode("utf-8")
+        data.decode("utf-8")
     except UnicodeDecodeError:
-        return data.decode("cp1252", errors="replace")
+        return Encoding("cp1252")
+    return Encoding("utf-8")
+
+
+def decode(data: bytes) -> str:
+    """Text of a .mcm file to check: a byte that does not read becomes U+FFFD (see
+    `encoding_of`); `decode_exact` is for text that is written back."""
+    return encoding_of(data).read(data, errors="replace")
+
+
+def decode_exact(data: bytes) -> tuple[str, Encoding]:
+    """A file's text and encoding such that `encoding.write(text) == data`, or EncodingError
+    naming the first byte that does not read (issue 20: `fmt` never writes U+FFFD back)."""
+    encoding = encoding_of(data)
+    try:
+        text = encoding.read(data)
+    except UnicodeDecodeError as e:
+        raise EncodingError(_undecodable(encoding, e)) from None
+    if encoding.write(text) != data:  # every codec above round-trips; a guard, not a case
+        raise EncodingError(f"its bytes do not read back the same as {_codec_name(encoding)}")
+    return text, encoding
+
+
+def _undecodable(encoding: Encoding, e: UnicodeDecodeError) -> str:
+    """'byte 0x81 at line 3, column 9 is not Windows-1252 (nor UTF-8): character maps to
+    <undefined>'."""
+    before = split_lines(e.object[:e.start].decode(encoding, errors="replace"))
+    bad = e.object[e.start:e.end]
+    what = " ".join(f"0x{b:02X}" for b in bad)
+    noun, verb = ("byte", "is") if len(bad) == 1 else ("bytes", "are")
+    return (f"{noun} {what} at line {len(before)}, column {len(before[-1]) + 1} {verb} not "
+            f"{_codec_name(encoding)}: {e.reason}")
+
+
+def _codec_name(encoding: Encoding) -> str:
+    """'Windows-1252', 'UTF-16-BE', ..., as a person names them."""
+    return {"utf-8-sig": "UTF-8 (the file begins with a UTF-8 byte-order mark)",
+            "cp1252": "Windows-1252 (nor UTF-8)"}.get(encoding, encoding.upper())
 
 
 def _utf16_without_bom(head: bytes) -> str | None:
@@ -74,13 +235,3 @@ def _utf16_without_bom(head: bytes) -> str | None:
     if even > 0.6 and odd == 0:
         return "utf-16-be"
     return None
-
-
-def read_source(path: str) -> Source:
-    """Read a file (or '-' for standard input); OSError propagates to the CLI."""
-    if path == "-":
-        import sys
-
-        return Source("<stdin>", decode(sys.stdin.buffer.read()))
-    with open(path, "rb") as f:
-        return Source(path, decode(f.read()))

@@ -3,19 +3,35 @@ a comment on the line (`// mercmac: ignore[nested-call]`).
 
 Only `check` reads these: `build`, `sim` and `flash` still refuse a file with errors.
 A syntax error is never turned off, as in ruff: the rest of its file was not checked.
+A comment that cannot be read turns nothing off and is reported (`invalid-suppression`,
+as ruff's RUF102 reports a `# noqa` with a code it does not know).
 """
 from __future__ import annotations
 
 import re
-from typing import Iterable
+import reprlib
+from typing import Iterable, NamedTuple
 
-from mercmac.diagnostics import RULES, Diagnostic, rule
+from mercmac.diagnostics import RULES, Diagnostic, Report, rule
 from mercmac.errors import UsageError
-from mercmac.source import Source
+from mercmac.source import Source, Span, split_lines
 
-# `// mercmac: ignore` (every rule) or `// mercmac: ignore[MM011, undefined-macro]`.
-_COMMENT = re.compile(r"//.*?\bmercmac:[ \t]*ignore\b(?:[ \t]*\[([^\]]*)\])?", re.IGNORECASE)
+# `// mercmac: ignore` (every rule) or `// mercmac: ignore[MM011, undefined-macro]`, in any
+# case. Matched inside a line's comment only, and without backtracking: the codes run to
+# the first `]` or the end of the line (group 2 empty: unclosed), so a line of repeated
+# `//` or `[` costs one pass (issue 20: a lazy `//.*?` before it was quadratic).
+_DIRECTIVE = re.compile(r"\bmercmac:[ \t]*ignore\b(?:[ \t]*\[([^\]]*)(\]?))?", re.IGNORECASE)
+_MENTION = re.compile("mercmac", re.IGNORECASE)
 _KEPT = "syntax"
+
+
+class Silenced(NamedTuple):
+    """What the comments of one line turn off, read once per line: every rule, or these
+    codes; and the diagnostics of the directives that could not be read."""
+
+    every: bool
+    codes: frozenset[str]
+    problems: tuple[Diagnostic, ...]
 
 
 def rule_set(keys: Iterable[str], option: str) -> frozenset[str]:
@@ -27,9 +43,20 @@ def rule_set(keys: Iterable[str], option: str) -> frozenset[str]:
         try:
             found.add(rule(key).code)
         except KeyError:
-            raise UsageError(f"{option}: no rule {key!r}",
+            raise UsageError(f"{option}: no rule {reprlib.repr(key)}",
                              hint="`mercmac explain` lists the codes and names") from None
     return frozenset(found)
+
+
+def selection(keys: Iterable[str], option: str) -> frozenset[str]:
+    """rule_set for a selection, refused when it names no rule: it would report nothing
+    and pass, which is never what `--select ''` or `select = []` meant (issue 20)."""
+    codes = rule_set(keys, option)
+    if not codes:
+        raise UsageError(f"{option} names no rule, so nothing would be reported",
+                         hint="name rules by code or name (MM011, undefined-macro); "
+                              "leave the selection out to report every rule")
+    return codes
 
 
 def chosen(select: frozenset[str] | None, ignore: frozenset[str]) -> frozenset[str]:
@@ -40,21 +67,58 @@ def chosen(select: frozenset[str] | None, ignore: frozenset[str]) -> frozenset[s
 
 def kept(diagnostics: Iterable[Diagnostic], rules: frozenset[str],
          source: Source) -> list[Diagnostic]:
-    """The diagnostics of the rules coded `rules` that no comment on their line turns off."""
-    out = []
-    for d in diagnostics:
-        if d.rule.code in rules and not _silenced(d, source.line(d.span.line)):
-            out.append(d)
-    return out
+    """The diagnostics of the rules coded `rules` that no comment on their line turns off,
+    with the `invalid-suppression` warnings of the comments that cannot be read."""
+    comments = silenced_lines(source)
+    problems = [p for line in comments.values() for p in line.problems]
+    return [d for d in [*diagnostics, *problems]
+            if d.rule.code in rules and not _silenced(d, comments.get(d.span.line))]
 
 
-def _silenced(d: Diagnostic, text: str) -> bool:
-    if d.rule.name == _KEPT or "mercmac" not in text:
+def silenced_lines(source: Source) -> dict[int, Silenced]:
+    """Line number -> what its comments turn off, for the lines that have a directive."""
+    if not _MENTION.search(source.text):  # most files: one scan, no split
+        return {}
+    found = {}
+    for number, text in enumerate(split_lines(source.text), 1):
+        start = text.find("//")
+        if start >= 0 and _MENTION.search(text, start):
+            line = _read(source.name, number, text, start)
+            if line is not None:
+                found[number] = line
+    return found
+
+
+def _read(file: str, number: int, text: str, start: int) -> Silenced | None:
+    """The directives in the comment of one line (it starts at `start`); None without any."""
+    every, codes, report = False, set(), Report(file)
+    matches = list(_DIRECTIVE.finditer(text, start))
+    for m in matches:
+        where = Span(number, m.start() + 1, number, m.end() + 1)
+        if m.group(1) is None:
+            every = True
+        elif not m.group(2):
+            report.add("invalid-suppression", where, "unclosed")
+        else:
+            codes |= _codes(m.group(1), where, report)
+    return Silenced(every, frozenset(codes), tuple(report.items)) if matches else None
+
+
+def _codes(keys: str, where: Span, report: Report) -> set[str]:
+    """The codes named in one directive's brackets (codes or names, any case); each
+    name that is no rule, or an empty list, is reported and turns nothing off."""
+    codes = set()
+    for key in filter(None, (k.strip() for k in keys.split(","))):
+        try:
+            codes.add(rule(key).code)
+        except KeyError:
+            report.add("invalid-suppression", where, "unknown", key=reprlib.repr(key))
+    if not keys.strip(", \t"):
+        report.add("invalid-suppression", where, "empty")
+    return codes
+
+
+def _silenced(d: Diagnostic, line: Silenced | None) -> bool:
+    if line is None or d.rule.name == _KEPT:
         return False
-    for match in _COMMENT.finditer(text):
-        if match.group(1) is None:
-            return True
-        keys = {k.strip().lower() for k in match.group(1).split(",")}
-        if d.rule.code.lower() in keys or d.rule.name in keys:
-            return True
-    return False
+    return line.every or d.rule.code in line.codes

@@ -93,13 +93,16 @@ def test_history_without_flashes_and_unreadable_records(data_dir):
     (data_dir / "history" / "other.json").write_text('{"format": 99}')
     result = cli("history")
     assert result.exit_code == 0 and "no flashes recorded yet" in result.output
-    assert json.loads(cli("history", "--format", "json").output) == {"flashes": []}
+    assert json.loads(cli("history", "--format", "json").stdout) == {"flashes": []}
+
+
+MINE = "// mine\n[MC05] MR5000,WS100\n[MC00] MA5\n"  # a source that builds to its record
 
 
 def test_lookup_matches_as_the_controller_stores_macros(data_dir):
     history.record(port="/dev/ttyUSB0", address=2, model="C-863", firmware="2.30",
-                   file="p.mcm", source="// mine\n", build=["MD5,MR5000,WS100", "MD0,MA5"])
-    assert history.lookup({5: "mr 5000 , ws100", 0: "MA+5"}).source == "// mine\n"
+                   file="p.mcm", source=MINE, build=["MD5,MR5000,WS100", "MD0,MA5"])
+    assert history.lookup({5: "mr 5000 , ws100", 0: "MA+5"}).source == MINE
     assert history.lookup({5: "MR5000,WS100"}) is None
     assert history.lookup({5: "MR5000,WS100", 0: "MA5", 7: "TP"}) is None
     assert history.lookup({}) is None
@@ -108,9 +111,9 @@ def test_lookup_matches_as_the_controller_stores_macros(data_dir):
 def test_lookup_prefers_this_port_and_address(data_dir):
     for port in ("/dev/a", "/dev/b", "/dev/c"):
         history.record(port=port, address=0, model="C-863", firmware="2.30", file=f"{port[-1]}.mcm",
-                       source=port, build=["MD5,MR5"])
-    assert history.lookup({5: "MR5"}, port="/dev/b", address=0).source == "/dev/b"
-    assert history.lookup({5: "MR5"}).source == "/dev/c"  # else the newest
+                       source=f"// {port}\n[MC05] MR5\n", build=["MD5,MR5"])
+    assert history.lookup({5: "MR5"}, port="/dev/b", address=0).source.startswith("// /dev/b")
+    assert history.lookup({5: "MR5"}).source.startswith("// /dev/c")  # else the newest
 
 
 def test_an_unwritable_history_does_not_fail_the_flash(tmp_path, monkeypatch, program):

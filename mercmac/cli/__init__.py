@@ -86,7 +86,7 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
         from mercmac.source import read_source
         from mercmac import suppress
 
-        chosen = suppress.rule_set(select, "--select") if select else None
+        chosen = suppress.selection(select, "--select") if select else None
         dropped = suppress.rule_set(ignore, "--ignore") if ignore else None
         paths, unreadable = _expand(files)
         results, found = [], []
@@ -95,8 +95,9 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
                 source = read_source(f)
             except OSError as e:
                 from mercmac.outfile import reason
+                from mercmac.render.report import printable
 
-                say(f"cannot read {f}: {reason(e)}")
+                say(f"cannot read {printable(f)}: {reason(e)}")
                 unreadable += 1
                 continue
             rules, model = _rules_for(f, chosen, dropped, target)
@@ -114,32 +115,32 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
 
 
 def _expand(arguments: tuple[str, ...]) -> tuple[list[str], int]:
-    """Files to check: each file as given, every .mcm below each folder (sorted); and how
-    many folders held none."""
-    import os
+    """The files the arguments name (mercmac.files); each skipped file or folder and each
+    folder without .mcm files said, and counted: they make the exit code 2."""
+    from mercmac.files import named_files
+    from mercmac.render.report import printable
 
-    paths, empty = [], 0
-    for a in arguments:
-        if a == "-" or not os.path.isdir(a):
-            paths.append(a)
-            continue
-        below = sorted(os.path.join(top, name) for top, _, names in os.walk(a)
-                       for name in names if name.endswith(".mcm"))
-        if not below:
-            say(f"no .mcm files in {a}")
-            empty += 1
-        paths += below
-    return paths, empty
+    named = named_files(arguments)
+    for path, why in named.skipped:
+        say(f"skipped {printable(path)}: {why}")
+    for folder in named.empty:
+        say(f"no .mcm files in {printable(folder)}")
+    return named.files, len(named.skipped) + len(named.empty)
 
 
 def _rules_for(path: str, select, ignore, target: str | None):
     """The rules to report on a file and its model: options, else its settings."""
     from mercmac import config, suppress
+    from mercmac.errors import UsageError
+    from mercmac.render.report import printable
 
-    settings = config.settings_for(path)
-    where = f"in {settings.path}"
+    try:
+        settings = config.settings_for(path)
+    except UsageError as e:  # it names a settings file, whose path may hold any character
+        raise UsageError(printable(e.message), hint=e.hint) from None
+    where = f"in {printable(settings.path)}" if settings.path else ""
     if select is None and settings.select is not None:
-        select = suppress.rule_set(settings.select, f"select {where}")
+        select = suppress.selection(settings.select, f"select {where}")
     if ignore is None:
         ignore = suppress.rule_set(settings.ignore or (), f"ignore {where}")
     return suppress.chosen(select, ignore), target or settings.target
@@ -252,8 +253,8 @@ def fmt_command(files: tuple[str, ...], check: bool, diff: bool) -> None:
     def work() -> int:
         from mercmac.cli.fmt import format_files
 
-        paths, empty = _expand(files)
+        paths, passed_over = _expand(files)
         code = format_files(tuple(paths), check=check, diff=diff) if paths else EXIT_USAGE
-        return EXIT_USAGE if empty else code
+        return EXIT_USAGE if passed_over else code
 
     run_guarded(work)

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import difflib
-import sys
 
 import click
 
@@ -29,26 +28,29 @@ def format_files(files: tuple[str, ...], *, check: bool, diff: bool) -> int:
 
 
 def _one(path: str, *, check: bool, diff: bool) -> bool | None:
-    """Whether PATH changed (or would); None when it could not be read, parsed or written."""
+    """Whether PATH changed (or would); None when it could not be read, parsed or written.
+
+    The bytes written are the formatted text in the file's own encoding and byte-order mark
+    (standard input's too), and the file is replaced only if it still holds what was read.
+    """
     from mercmac import outfile
     from mercmac.fmt import FormatError, format_text, load
+    from mercmac.source import read_bytes
 
     name = "<stdin>" if path == "-" else path
     try:
-        data = sys.stdin.buffer.read() if path == "-" else _read(path)
-        text, codec = load(data)
+        data = read_bytes(path)
+        before = None if path == "-" else outfile.snapshot(path, data)
+        text, encoding = load(data)
         formatted = format_text(text)
         if diff and formatted != text:
-            click.echo("".join(difflib.unified_diff(
-                text.splitlines(keepends=True), formatted.splitlines(keepends=True),
-                name, name)), nl=False)
+            _show_diff(text, formatted, name)
         elif path == "-" and not check:
-            click.echo(formatted, nl=False)
+            click.echo(encoding.write(formatted), nl=False)  # bytes: as they came in
         elif check and formatted != text:
             say(f"would reformat {name}")
         elif formatted != text and not check:
-            formatted.encode(codec)  # UnicodeEncodeError before the file is touched
-            outfile.write_text(path, formatted, encoding=codec)
+            outfile.write_bytes(path, encoding.write(formatted), expect=before)
         return formatted != text
     except FormatError as e:
         say(f"cannot format {name}: {e.message}", e.hint)
@@ -61,9 +63,12 @@ def _one(path: str, *, check: bool, diff: bool) -> bool | None:
     return None
 
 
-def _read(path: str) -> bytes:
-    with open(path, "rb") as f:
-        return f.read()
+def _show_diff(text: str, formatted: str, name: str) -> None:
+    from mercmac.source import split_lines
+
+    click.echo("".join(difflib.unified_diff(split_lines(text, keepends=True),
+                                            split_lines(formatted, keepends=True), name, name)),
+               nl=False)
 
 
 def _summary(changed: int, unchanged: int, failed: int, *, dry: bool) -> None:

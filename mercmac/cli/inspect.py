@@ -12,12 +12,14 @@ from dataclasses import dataclass
 import click
 
 from mercmac.cli.common import run_guarded
-from mercmac.cli.upload import _ADDRESS, _BAUD, _TIMEOUT, _timing
+from mercmac.cli.upload import (_ADDRESS, _BAUD, _TIMEOUT, _timing, file_name, history_records,
+                                one_port, recalled)
 from mercmac.errors import EXIT_FAILED, EXIT_OK, UsageError
 
 _SOURCE = [
     click.argument("file", required=False, type=click.Path(dir_okay=False, allow_dash=True)),
-    click.option("--port", help="Read the controller on this port instead of a file."),
+    click.option("--port", multiple=True, callback=one_port,
+                 help="Read the controller on this port instead of a file."),
     _ADDRESS, _BAUD, _TIMEOUT,  # the uploader's own options, used with --port
 ]
 
@@ -72,12 +74,14 @@ def _read_file(file: str) -> Macros:
 
 
 def _recorded(read: Macros):
-    """The history record of exactly these macros, said on standard error; else None."""
-    from mercmac.upload import history
+    """The history record whose source gives back these macros, said on standard error;
+    else None (a record whose source no longer builds to them is said too)."""
+    from mercmac.render.history import label
+    from mercmac.render.report import printable
 
-    found = history.lookup(read.macros, port=read.port, address=read.address)
+    found = recalled(read.macros, read.port, read.address, "decompiled instead")
     if found:
-        click.echo(f"mercmac: {read.origin} holds {found.label}", err=True)
+        click.echo(f"mercmac: {printable(read.origin)} holds {label(found)}", err=True)
     return found
 
 
@@ -100,6 +104,23 @@ def _write(text: str, output: str | None) -> None:
         click.echo(text, nl=False)
 
 
+def _not_the_input(file: str | None, output: str | None) -> None:
+    """UsageError when OUTPUT is FILE (the same file by any name): the decompiled source
+    would replace the program the user wrote, its comments and names with it."""
+    import os
+
+    if not file or not output or "-" in (file, output):
+        return
+    try:
+        same = os.path.samefile(file, output)
+    except (OSError, ValueError):
+        return  # one of them does not exist (yet): reading or writing says what is wrong
+    if same:
+        raise UsageError(f"-o {output} is the input file {file}: the decompiled source would "
+                         f"replace it, and its comments would be lost",
+                         hint="give another output file, or --force to replace the input")
+
+
 def _guarded(work) -> None:
     def guarded() -> int:
         try:
@@ -113,8 +134,9 @@ def _guarded(work) -> None:
 @click.command()
 @_from_file_or_port
 @click.option("-o", "--output", type=click.Path(dir_okay=False, allow_dash=True),
-              help="Write the source to this file instead of standard output.")
-def decompile(file, port, address, baud, timeout, output) -> None:
+              callback=file_name, help="Write the source to this file instead of standard output.")
+@click.option("--force", is_flag=True, help="Write the source even over FILE itself.")
+def decompile(file, port, address, baud, timeout, output, force) -> None:
     """Turn raw macros back into high-level source that builds to exactly the same macros.
 
     FILE is a .mcm file of `[MCnn]` blocks (a pull, a backup); --port reads the
@@ -124,6 +146,8 @@ def decompile(file, port, address, baud, timeout, output) -> None:
     be opened.
     """
     def work() -> int:
+        if not force:
+            _not_the_input(file, output)  # refused before a port is read
         read = _read(file, port, address, baud, timeout)
         found = _recorded(read)
         if found:
@@ -140,7 +164,7 @@ def decompile(file, port, address, baud, timeout, output) -> None:
 @_from_file_or_port
 @click.option("--format", "fmt", type=click.Choice(["text", "markdown", "json"]), default="text",
               show_default=True, help="text for people, markdown for documents, json for programs.")
-@click.option("--graph", type=click.Path(dir_okay=False),
+@click.option("--graph", type=click.Path(dir_okay=False), callback=file_name,
               help="Also write the call graph: FILE.dot as Graphviz text, FILE.svg drawn by "
                    "Graphviz's `dot` (which must be installed).")
 def describe(file, port, address, baud, timeout, fmt, graph) -> None:
@@ -149,14 +173,14 @@ def describe(file, port, address, baud, timeout, fmt, graph) -> None:
     FILE is a .mcm file; --port reads the controller instead.
     """
     def work() -> int:
-        graph_kind = _graph_kind(graph) if graph else None  # refused before the port is read
+        graph_kind = _graph_kind(graph) if graph is not None else None  # before the port is read
         read = _read(file, port, address, baud, timeout)
         library = _library()
         text = library.describe(read.macros, model=read.model, fmt=fmt)
-        if graph:
+        if graph is not None:
             _write_graph(library.call_graph_dot(read.macros, model=read.model), graph, graph_kind)
         click.echo(text, nl=not text.endswith("\n"))
-        if graph:
+        if graph is not None:
             click.echo(f"mercmac: call graph written to {graph}", err=True)
         return EXIT_OK
 
@@ -212,9 +236,8 @@ def history(fmt) -> None:
     def work() -> int:
         from mercmac.render import history as view
         from mercmac.render.console import write_lines
-        from mercmac.upload import history as records
 
-        found = records.records()
+        found = history_records()  # a file that is no record is named on standard error
         if fmt == "json":
             click.echo(view.to_json(found))
         else:

@@ -20,7 +20,7 @@ def lsp() -> None:
                 say(MISSING)
                 return EXIT_USAGE
             raise
-        main()
+        main(say)
         return EXIT_OK
 
     run_guarded(work)

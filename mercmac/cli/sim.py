@@ -8,6 +8,7 @@ from __future__ import annotations
 import click
 
 from mercmac.cli.common import MODEL_CHOICE, FiniteFloat, run_guarded
+from mercmac.cli.upload import file_name
 from mercmac.commands import MAX_INT32
 from mercmac.errors import EXIT_FAILED, EXIT_OK
 
@@ -25,11 +26,11 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
 @click.option("-v", "--verbose", count=True,
               help="Timeline detail: -v adds macro entries and exits, -vv shows everything.")
 @click.option("--trace", is_flag=True, help="Show every executed instruction, disassembled.")
-@click.option("--vcd", type=click.Path(dir_okay=False), metavar="OUT",
+@click.option("--vcd", type=click.Path(dir_okay=False), metavar="OUT", callback=file_name,
               help="Write a Value Change Dump (GTKWave, Surfer) to OUT.")
 @click.option("--vcd-limit", type=click.FloatRange(min=0), default=100, show_default=True,
               metavar="MB", help="Stop the VCD before it passes this size (0: no limit).")
-@click.option("--plot", type=click.Path(dir_okay=False), metavar="FILE",
+@click.option("--plot", type=click.Path(dir_okay=False), metavar="FILE", callback=file_name,
               help="Draw position, buttons, LEDs and macro over time: .png, .svg, .pdf or "
                    ".html (zooms and pans). Needs the extra: pip install 'mercmac[plot]'.")
 @click.option("--interactive", is_flag=True,
@@ -39,6 +40,7 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
 @click.option("--speed", type=FiniteFloat(), default=1.0, show_default=True,
               help="Simulated seconds per wall-clock second in --interactive.")
 @click.option("--scenario", type=click.Path(dir_okay=False), metavar="FILE.toml",
+              callback=file_name,
               help="Timed button steps and expectations; exit 1 on the first that fails. "
                    "Not with --buttons: the scenario's steps are the button script.")
 @click.option("--fail-on-hazard", is_flag=True, help="Exit 1 when the run finds any hazard (for CI).")

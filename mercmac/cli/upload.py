@@ -19,7 +19,24 @@ _FIND_ADDRESS = click.option("--address", type=click.IntRange(0, 15), default=No
                              help="Controller address, DIP switches 1-4 (MS176E §3.1.3). "
                                   "Default: 0 if a controller answers there, else the only "
                                   "address that answers (1-15 searched, about 5 s).")
-_PORT_OPTION = click.option("-p", "--port", "port_option", metavar="PORT",
+def one_port(ctx, param, values: tuple):
+    """An option given at most once (multiple=True collects them): `-p A -p B` is refused,
+    where click would silently keep B."""
+    if len(values) > 1:
+        shown = ", ".join(repr(v) for v in values)
+        raise click.BadParameter(f"given {len(values)} times ({shown}): give the port once")
+    return values[0] if values else None
+
+
+def file_name(ctx, param, value: str | None):
+    """A file name option: '' is refused (it names no file, and would write nothing)."""
+    if value == "":
+        raise click.BadParameter("an empty file name: give the path of a file")
+    return value
+
+
+_PORT_OPTION = click.option("-p", "--port", "port_option", metavar="PORT", multiple=True,
+                            callback=one_port,
                             help="The port, as PORT; default: $MERCMAC_PORT, else the only PI USB "
                                  "device (vendor 0x1A72), else the only serial port.")
 _BAUD = click.option("--baud", type=click.IntRange(300, 921_600), default=9600, show_default=True,
@@ -52,7 +69,7 @@ def _timing(timeout: float):
 @_FIND_ADDRESS
 @_BAUD
 @click.option("--dry-run", is_flag=True, help="Read back and show the exact bytes; write nothing.")
-@click.option("--backup", type=click.Path(dir_okay=False, writable=True),
+@click.option("--backup", type=click.Path(dir_okay=False, writable=True), callback=file_name,
               help="Where to save what the controller holds (default: a timestamped file "
                    "in the per-user data directory).")
 @click.option("--erase-unused", is_flag=True, help="Remove stored macros the file does not define.")
@@ -157,7 +174,7 @@ def _watch(port: str, address: int | None, finished: list):
 @click.argument("port", required=False, metavar="[PORT]")
 @_PORT_OPTION
 @click.option("-o", "--output", type=click.Path(dir_okay=False, allow_dash=True),
-              help="Write the .mcm file here instead of standard output.")
+              callback=file_name, help="Write the .mcm file here instead of standard output.")
 @_FIND_ADDRESS
 @_BAUD
 @_TIMEOUT
@@ -192,9 +209,7 @@ def pull(port, port_option, output, address, baud, timeout, raw) -> None:
         address = pulled.identity.address
         text, found = pulled.text, None
         if not raw:  # a program mercmac flashed comes back as its source (upload.history)
-            from mercmac.upload import history
-
-            found = history.lookup(pulled.macros, port=port, address=address)
+            found = recalled(pulled.macros, port, address, "the stored macros are given back")
             text = found.source if found else text
         if to_file:
             try:
@@ -207,11 +222,39 @@ def pull(port, port_option, output, address, baud, timeout, raw) -> None:
         write_lines(view.identity_lines(port, address, pulled.identity), err)
         write_lines(view.pulled_lines(pulled, port, address, output if to_file else None), err)
         if found:
-            click.echo(f"the controller holds {found.label}: that source is given back "
+            from mercmac.render.history import label
+
+            click.echo(f"the controller holds {label(found)}: that source is given back "
                        f"(--raw for the stored macros)", err=True)
         return EXIT_OK
 
     run_guarded(work)
+
+
+def history_records() -> list:
+    """The flash history's records, newest first; each file that is no record is named on
+    standard error, once (upload.history.read)."""
+    from mercmac.render import history as view
+    from mercmac.render.console import write_lines
+    from mercmac.upload import history
+
+    shelf = history.read()
+    write_lines(view.skipped_lines(shelf.skipped), sys.stderr)
+    return shelf.records
+
+
+def recalled(macros: dict[int, str], port: str | None, address: int | None, instead: str):
+    """The history record whose source gives back `macros` (upload.history.recall), or None;
+    a record of exactly this build whose source no longer builds to it is said, with `instead`."""
+    from mercmac.render import history as view
+    from mercmac.render.console import write_lines
+    from mercmac.upload import history
+
+    found = history.recall(macros, history_records(), port=port, address=address)
+    if found.stale:
+        write_lines([[("warning: ", "bold yellow"), (view.stale_text(found, instead), "")]],
+                    sys.stderr)
+    return found.record
 
 
 def _check_output(path) -> None:

@@ -31,11 +31,13 @@ from mercmac.source import Span
 class _Macro:
     """A macro being lowered: its EM targets may not have slots yet."""
 
-    __slots__ = ("name", "origin", "span", "slot", "ops")
+    __slots__ = ("name", "origin", "span", "slot", "ops", "root", "depth")
 
     def __init__(self, name: str, origin: Origin, span: Span, slot: int | None = None):
         self.name, self.origin, self.span, self.slot = name, origin, span, slot
         self.ops: list = []  # Op, or _Em before allocation
+        self.root: _Macro | None = None  # of a helper: the user's macro it was made for
+        self.depth = 0  # of a helper: how many owners it has, the root one included
 
 
 class _Em(NamedTuple):
@@ -62,10 +64,57 @@ def _calls_on(ops: list) -> bool:
 
 def _unchained(ops: list) -> list:
     """A line with its chained parts (tail EMs 'continue' to a part) read back as one."""
-    last = ops[-1] if ops else None
-    if isinstance(last, _Em) and last.role is Role.CONTINUE and last.target.origin is Origin.PART:
-        return ops + _unchained(last.target.ops)  # the tail EM stays: it is a call too
-    return ops
+    whole = list(ops)
+    last = whole[-1] if whole else None
+    # a loop, not recursion: a long block is chained into thousands of parts (issue 20)
+    while (isinstance(last, _Em) and last.role is Role.CONTINUE
+           and last.target.origin is Origin.PART):
+        whole += last.target.ops  # the tail EM stays: it is a call too
+        last = whole[-1]
+    return whole
+
+
+class _Todo:
+    """The statements of a line still to lower. A body that runs in a statement's place
+    (a loop that runs once, an inlined callee) is pushed, not joined to the rest: a line
+    of thousands of them was a recursion and a copy per statement (issue 20)."""
+
+    __slots__ = ("frames", "last")
+
+    def __init__(self, stmts: tuple, span: Span):
+        self.frames: list[list] = []  # [statements, index of the next one], innermost last
+        self.last = span
+        self.splice(stmts, span)
+
+    def __bool__(self) -> bool:
+        return bool(self.frames)
+
+    def peek(self):
+        stmts, i = self.frames[-1]
+        return stmts[i]
+
+    def pop(self):
+        stmt, frame = self.peek(), self.frames[-1]
+        frame[1] += 1
+        if frame[1] == len(frame[0]):
+            self.frames.pop()
+        return stmt
+
+    def splice(self, stmts: tuple, span: Span) -> None:
+        """Lower `stmts` next. `last` is the span of the line's last statement (its tail
+        EM points there), `span` (the owner's) when it has none."""
+        if not self.frames:
+            self.last = stmts[-1].span if stmts else span
+        if stmts:
+            self.frames.append([stmts, 0])
+
+
+class _Taker(NamedTuple):
+    """A hoisted block that takes its line's return point, and the rest it continues to."""
+
+    stmt: object
+    block: _Macro
+    after: _Macro
 
 
 def _is_em(op) -> bool:
@@ -76,6 +125,8 @@ class _Lowerer:
     def __init__(self, env: Env, report: Report, inline: frozenset = frozenset()):
         self.env, self.report = env, report
         self.order: list[_Macro] = []
+        self.names: set[str] = set()  # of the macros in `order`: a name is looked up, not searched
+        self.next_part: dict[str, int] = {}  # owner -> the first part number that may be free
         self.named: dict[str, _Macro] = {}
         self.inlinable = inline  # named macros whose calls with code after them are inlined
         self.budget = 4000  # statements that inlining may copy: hostile input stays cheap
@@ -83,18 +134,42 @@ class _Lowerer:
         self.warned: set = set()
         self.inlined: set[str] = set()
         self.added: set[int] = set()  # id() of the RPs and WAs a loop adds: the user did not write them
+        self.calling_blocks: set[tuple] = set()  # (id(stmt), leaf) of hoisted blocks that call on
+        self.too_long: set[_Macro] = set()  # loop lines reported as too long to split
 
     def new(self, name: str, origin: Origin, span: Span, slot: int | None = None) -> _Macro:
         m = _Macro(name, origin, span, slot)
         self.order.append(m)
+        self.names.add(name)
         return m
 
+    def mark(self) -> tuple[int, int]:
+        """Where the lowering stands: the macros made and the diagnostics given so far."""
+        return len(self.order), len(self.report.items)
+
+    def forget(self, mark: tuple[int, int]) -> None:
+        """Drop what was lowered since `mark`: its macros (their names are free again) and
+        its diagnostics (the lowering that is kept gives its own, once)."""
+        made, said = mark
+        self.names.difference_update(m.name for m in self.order[made:])
+        self.next_part.clear()  # a dropped part's number may be taken again
+        del self.order[made:]
+        self.warned.difference_update(d.span for d in self.report.items[said:]
+                                      if d.rule.name == "ti-moved")
+        del self.report.items[said:]
+
     def helper(self, owner: _Macro, kind: str, span: Span) -> _Macro:
-        """A compiler-made macro, named after its owner and line: 'jog.when@12'."""
-        name = f"{owner.name}.{kind}@{span.line}"
-        if any(m.name == name for m in self.order):  # two blocks on one line
+        """A compiler-made macro, named after its owner and line: 'jog.when@12'. One made
+        for more owners than the controller has slots cannot be stored with them: it is
+        named after the user's macro alone ('jog.rest@90'), so that a chain of thousands
+        of rests does not make names thousands of owners long (issue 20)."""
+        root = owner.root or owner
+        name = f"{(owner if owner.depth < len(SLOTS) else root).name}.{kind}@{span.line}"
+        if name in self.names:  # two blocks on one line
             name += f":{span.column}"
-        return self.new(name, Origin(kind), span)
+        made = self.new(name, Origin(kind), span)
+        made.root, made.depth = root, owner.depth + 1
+        return made
 
     # -- statements --------------------------------------------------------
     def seq(self, stmts: tuple, owner: _Macro, *, at_start: bool, loop: bool,
@@ -105,59 +180,105 @@ class _Lowerer:
         `leaf`: the line is called from a loop and must call nothing, so small
         repeats are unrolled. `nest`: a loop at the start of the line may stay in
         it (false in a loop whose TI would then read an inner RP's counter).
+
+        Where a hoisted block takes the return point, the rest of the line is a
+        line of its own; the rests are lowered one after another (a chain of
+        thousands recursed, issue 20), then each block with its rest as its tail,
+        the last first: the order the macros were always made in.
         """
+        todo, takers = _Todo(stmts, owner.span), []
+        ops, taker = self.line(todo, owner, at_start=at_start, loop=loop, cont=cont, leaf=leaf,
+                               nest=nest)
+        while taker is not None:
+            takers.append(taker)
+            if not todo:  # nothing followed the block: its tail is `cont`
+                break
+            rest = taker.after
+            rest.ops, taker = self.line(todo, rest, at_start=True, loop=False, cont=cont, leaf=leaf)
+        for stmt, block, after in reversed(takers):
+            block.ops = self.block_ops(stmt, block, after, leaf)
+        return ops
+
+    def line(self, todo: _Todo, owner: _Macro, *, at_start: bool, loop: bool,
+             cont: _Macro | None, leaf: bool, nest: bool = True) -> tuple[list, _Taker | None]:
+        """The ops of one line (see `seq`) and the hoisted block that took its return
+        point, if one did: what is left in `todo` is then that block's rest."""
         out: list = []
-        for i, stmt in enumerate(stmts):
-            rest = stmts[i + 1:]
-            first = at_start and not out
-            again = dict(owner=owner, at_start=first, loop=loop, cont=cont, leaf=leaf, nest=nest)
-            if isinstance(stmt, ast.Command):
+        while todo:
+            stmt = todo.pop()
+            more, first = bool(todo), at_start and not out
+            if isinstance(stmt, ast.Goto):
+                target = self.named.get(stmt.name)  # a goto transfers for good: nothing after it runs
+                return out + ([] if target is None else [_Em(target, stmt.span, Role.GOTO)]), None
+            if isinstance(stmt, ast.Repeat) and self.count(stmt) == 0:
+                continue  # `repeat 0` runs nothing (reported as info)
+            body = self.spliced(stmt, more or cont is not None or loop, leaf and not first)
+            if body is not None:
+                todo.splice(body, owner.span)  # runs here, before what follows the statement
+            elif isinstance(stmt, ast.Command):
                 if stmt in self.env.ops:
                     out.append(self.command(self.env.ops[stmt], owner))
-            elif isinstance(stmt, ast.Goto):
-                target = self.named.get(stmt.name)
-                if target is not None:
-                    out.append(_Em(target, stmt.span, Role.GOTO))
-                return out  # a goto transfers for good: nothing after it runs
             elif isinstance(stmt, ast.Call):
-                if (rest or cont is not None or loop) and self.inline(stmt):
-                    # The callee calls on, so a call with code after it would need a
-                    # second return point: its body runs here instead.
-                    return out + self.seq(self.env.macros[stmt.name].body + rest, **again)
                 target = self.named.get(stmt.name)
                 if target is not None:
                     out.append(_Em(target, stmt.span, Role.CALL))
-            elif isinstance(stmt, ast.Repeat) and self.count(stmt) == 0:
-                continue  # `repeat 0` runs nothing (reported as info)
-            elif isinstance(stmt, (ast.Repeat, ast.Every)) and self.once(stmt):
-                return out + self.seq(stmt.body + rest, **again)
-            elif isinstance(stmt, ast.Repeat) and leaf and not first and self.unrollable(stmt):
-                return out + self.seq(stmt.body * self.count(stmt) + rest, **again)
-            elif isinstance(stmt, ast.When) and not rest and not loop and cont is None:
-                return out + self.conditions(stmt) + self.seq(stmt.body, owner, at_start=False,
-                                                              loop=False, leaf=leaf, nest=nest)
+            elif isinstance(stmt, ast.When) and not more and not loop and cont is None:
+                out += self.conditions(stmt)  # a block that ends the line stays on it
+                todo.splice(stmt.body, owner.span)
+                at_start = False
             elif (isinstance(stmt, (ast.Repeat, ast.Every)) and first and nest
                   and not (loop and _has_ti(stmt.body))):
                 # RP jumps to the start of the line: a loop that starts its line stays in
                 # it, and what follows runs on the same line once the loop is done.
                 out += self.loop_ops(stmt, owner, leaf)
             else:
-                block = self.helper(owner, type(stmt).__name__.lower(), stmt.span)
+                block, after = self.hoist(stmt, owner, todo, cont,
+                                          may_take=bool(more or cont) and not loop,
+                                          leaf=loop or leaf)
                 out.append(_Em(block, stmt.span, Role.HOIST))
-                mark = len(self.order)
-                block.ops = self.block_ops(stmt, block, None, loop or leaf)
-                if (rest or cont) and not loop and _calls_on(block.ops):
-                    # The block takes the return point: what follows it continues in
-                    # a macro that both the block and this line reach by a tail EM.
-                    del self.order[mark:]
-                    after = cont
-                    if rest:
-                        after = self.helper(owner, "rest", rest[0].span)
-                        after.ops = self.seq(rest, after, at_start=True, loop=False, cont=cont,
-                                             leaf=leaf)
-                    block.ops = self.block_ops(stmt, block, after, leaf)
-                    return out + _tail(after, stmt.span)
-        return out + _tail(cont, stmts[-1].span if stmts else owner.span)
+                if after is not None:
+                    return out + _tail(after, stmt.span), _Taker(stmt, block, after)
+        return out + _tail(cont, todo.last), None
+
+    def spliced(self, stmt, code_after: bool, unroll: bool) -> tuple | None:
+        """The statements that run in place of `stmt` on its line, if any: the body of a
+        callee that calls on (a call with code after it would need a second return
+        point), of a loop that runs once, of a small repeat on a line that must call nothing."""
+        if isinstance(stmt, ast.Call):
+            return self.env.macros[stmt.name].body if code_after and self.inline(stmt) else None
+        if isinstance(stmt, (ast.Repeat, ast.Every)) and self.once(stmt):
+            return stmt.body
+        if isinstance(stmt, ast.Repeat) and unroll and self.unrollable(stmt):
+            return stmt.body * self.count(stmt)
+        return None
+
+    def hoist(self, stmt, owner: _Macro, todo: _Todo, cont: _Macro | None, *,
+              may_take: bool, leaf: bool) -> tuple[_Macro, _Macro | None]:
+        """Move a block into a macro of its own. If code follows it (`may_take`) and the
+        block calls on, it takes the return point: what follows continues in `after`, a
+        macro (or the line's `cont`) that both the block and the line reach by a tail EM,
+        and the block is lowered once that is (see `seq`)."""
+        block = self.helper(owner, type(stmt).__name__.lower(), stmt.span)
+        if not may_take:
+            block.ops = self.block_ops(stmt, block, None, leaf)
+        elif self.calls_on_alone(stmt, block, leaf):
+            return block, self.helper(owner, "rest", todo.peek().span) if todo else cont
+        return block, None
+
+    def calls_on_alone(self, stmt, block: _Macro, leaf: bool) -> bool:
+        """Whether a hoisted block, lowered alone, calls on. If not, that lowering is the
+        block's; if so, it is dropped and the answer kept: a block in nested blocks that
+        call on was asked again in each lowering of theirs, 2^depth times (issue 20)."""
+        key = (id(stmt), leaf)  # the AST outlives the lowering: ids stay unique
+        if key in self.calling_blocks:
+            return True
+        mark = self.mark()
+        block.ops = self.block_ops(stmt, block, None, leaf)
+        if not _calls_on(block.ops):
+            return False
+        self.forget(mark)
+        self.calling_blocks.add(key)
+        return True
 
     def command(self, op: Op, owner: _Macro) -> Op:
         """A native command; a TI moved away from the RP of its loop is reported."""
@@ -280,6 +401,9 @@ class _Lowerer:
     def too_long_loop(self, m: _Macro) -> None:
         """A loop line that cannot be split, said in the user's terms: the commands they
         wrote, and the RP (WA) the loop adds, which they did not."""
+        if m in self.too_long:
+            return  # `split` fits every macro again
+        self.too_long.add(m)
         added = [op for op in m.ops if id(op) in self.added or
                  (isinstance(op, _Em) and op.role in (Role.HOIST, Role.CONTINUE))]
         loop = next((op.span for op in added if isinstance(op, Op)), m.span)
@@ -289,20 +413,22 @@ class _Lowerer:
 
     def part_name(self, m: _Macro) -> str:
         """'jog.part2', 'jog.part3', ...: the next free part name of a split macro."""
-        names = {x.name for x in self.order}
-        n = 2
-        while f"{m.name}.part{n}" in names:
+        n = self.next_part.get(m.name, 2)  # not from 2 each time: thousands of parts (issue 20)
+        while f"{m.name}.part{n}" in self.names:
             n += 1
+        self.next_part[m.name] = n + 1
         return f"{m.name}.part{n}"
 
     def chain(self, m: _Macro) -> None:
-        part = m
-        while len(part.ops) > MAX_COMMANDS:
+        """Cut a line into parts of 15 commands and a tail EM to the next, the last part
+        whole; each part is sliced once from the line (not the rest again at every cut)."""
+        ops, part, keep, start = m.ops, m, MAX_COMMANDS - 1, 0
+        while len(ops) - start > MAX_COMMANDS:
             tail = self.new(self.part_name(m), Origin.PART, m.span)
-            keep = MAX_COMMANDS - 1
-            tail.ops, part.ops = part.ops[keep:], part.ops[:keep]
-            part.ops.append(_Em(tail, _span_of(tail.ops[0], m.span), Role.CONTINUE))
-            part = tail
+            part.ops = ops[start:start + keep] + [
+                _Em(tail, _span_of(ops[start + keep], m.span), Role.CONTINUE)]
+            part, start = tail, start + keep
+        part.ops = ops[start:]
 
     def allocate(self) -> dict[int, _Macro]:
         taken: dict[int, _Macro] = {}

@@ -6,6 +6,7 @@ from typing import NamedTuple
 
 from mercmac import mdtext
 from mercmac.commands import C663, C863, MODELS, Mnemonic, lookup
+from mercmac.source import split_lines
 
 CONDITIONS = (Mnemonic.XN, Mnemonic.XF)
 _HEADER = re.compile(r"\s*(?:\[\s*MC\s*\+?\s*(\d+)\s*\]|MC\s*(\d+)\b|MD\s*(\d+)\s*(?:,|$))(.*)",
@@ -26,7 +27,7 @@ class Line(NamedTuple):
 def read_macros(text: str) -> dict[int, str]:
     """The macros of a `[MCnn]` file, `MDn,...` lines or a `TM` report, by slot (last wins)."""
     macros: dict[int, str] = {}
-    for raw in text.splitlines():
+    for raw in split_lines(text):
         m = _HEADER.match(raw.split("//", 1)[0])
         if m and any(m.group(i) for i in (1, 2, 3)):
             slot = int(next(g for g in m.groups()[:3] if g))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 from mercmac.commands import C663, Mnemonic, lookup
+from mercmac.render.sim import plural
 from mercmac.decompile.lines import (Line, condition_run, every_period, model_of, names,
                                      read_lines)
 
@@ -85,8 +86,7 @@ class _Reader:
         if m in (Mnemonic.CN, Mnemonic.CF):
             return f"LED {n} {'on' if m == Mnemonic.CN else 'off'}"
         if m == Mnemonic.RP:
-            return ("repeat the line 65,535 more times" if n is None
-                    else f"repeat the line {n:,} more time{'s' if n != 1 else ''}")
+            return f"repeat the line {plural(65535 if n is None else n, 'more time')}"
         if m == Mnemonic.FE:
             return f"search the reference (FE{0 if n is None else n})"
         summary = lookup(m).summary.split(":")[0].split(" (")[0]
@@ -220,7 +220,7 @@ def describe(macros: dict[int, str], *, model: str | None = None, fmt: str = "te
 
 def _title(reader: _Reader, data: dict) -> str:
     model = f"a {reader.model}" if reader.model else "a Mercury controller (model unknown)"
-    return f"{len(reader.lines)} macros for {model}; distances in {reader.unit}"
+    return f"{plural(len(reader.lines), 'macro')} for {model}; distances in {reader.unit}"
 
 
 def _sections(reader: _Reader, data: dict) -> list[tuple[str, list[str]]]:

@@ -9,16 +9,26 @@ is checked by compiling the whole source and comparing the slots.
 from __future__ import annotations
 
 from collections import Counter
+from typing import NamedTuple
 
 from mercmac import mdtext
 from mercmac.commands import Mnemonic
-from mercmac.compiler import compile_source
 from mercmac.decompile.lines import (CONDITIONS, Line, condition_run, every_period, model_of,
                                      names, read_lines)
 from mercmac.diagnostics import Severity
-from mercmac.source import Source
+from mercmac.render.report import printable
 
 RAW, NATIVE, PLAIN, FOLD = 0, 1, 2, 3  # how richly a slot is written
+# How deep folded blocks may nest. The compiler lowers a hoisted block that calls on twice
+# (once to learn that it does), so each level doubles the work of checking a candidate:
+# a chain of conditional slots folded into one another took 17 s at 20 slots, past 300 s
+# at 24 (issue 20, item 7).
+MAX_NEST = 4
+# Compiles one decompile may spend per slot. The search needs at most about seven per slot
+# (raise, again for callers, fold, unpin by halves); the examples use three or fewer. Past
+# the budget, each slot stays as the search left it, which is exact already: a bound on
+# the time of any 32-slot program (benchmarks/decompile_speed.py), whatever its shape.
+COMPILES_PER_SLOT = 4
 _LOOP_STOP = (Mnemonic.RP, Mnemonic.TI)  # what a loop body may not hold (RP, TI: the counter)
 
 
@@ -31,10 +41,23 @@ class _Writer:
         self.pinned = {s: True for s in lines}
         self.why: dict[int, str] = {}
         self.fold_ok: set[int] = set(lines)  # helpers that may fold into their caller
+        self.too_deep: set[int] = set()  # helpers left unfolded to bound the nesting
         self.counts = Counter(t for line in lines.values() for t in line.ems())
 
     # -- which slots fold into their caller -----------------------------------------------------
     def folds(self) -> dict[int, int]:
+        """helper slot -> caller slot, nested at most MAX_NEST deep: past that, the
+        shallowest helpers too deep stay macros of their own, and the rest is folded again."""
+        self.too_deep = set()
+        while True:
+            out = self._folds()
+            depth = _depths(out)
+            deep = {h for h, d in depth.items() if d > MAX_NEST}
+            if not deep:
+                return out
+            self.too_deep |= {h for h in deep if depth[h] == min(depth[d] for d in deep)}
+
+    def _folds(self) -> dict[int, int]:
         """helper slot -> caller slot, for hoisted `when` and loop macros (and the rest
         after a loop that calls out) written back in their caller."""
         out: dict[int, int] = {}
@@ -78,7 +101,7 @@ class _Writer:
         line = self.lines.get(slot)
         return (line is not None and line.ops is not None and slot not in (0, caller)
                 and self.counts[slot] == 1 and self.levels[slot] != RAW
-                and slot in self.fold_ok)
+                and slot in self.fold_ok and slot not in self.too_deep)
 
     def _loop(self, slot: int) -> tuple | None:
         """(head, body, rest slot) of a hoisted `repeat N`/`every T` line, else None."""
@@ -183,6 +206,18 @@ class _Writer:
         return [", ".join(_native(op) for op in ops)]
 
 
+def _depths(folded: dict[int, int]) -> dict[int, int]:
+    """helper -> how many folded blocks it stands in (1: in a macro of its own); a cycle
+    of folds counts as deeper than any bound."""
+    out: dict[int, int] = {}
+    for helper in folded:
+        depth, at = 1, folded[helper]
+        while at in folded and depth <= MAX_NEST:
+            depth, at = depth + 1, folded[at]
+        out[helper] = depth
+    return out
+
+
 def _em_to(op) -> int | None:
     return op.arg if op.mnemonic == Mnemonic.EM else None
 
@@ -230,31 +265,64 @@ def _indent(lines: list[str]) -> list[str]:
 
 # -- checking a candidate ---------------------------------------------------------------------------
 
-class _Result:
-    def __init__(self, text: str, exact: bool, noise: Counter):
-        self.text, self.exact, self.noise = text, exact, noise
+class _Result(NamedTuple):
+    exact: bool  # the text builds to exactly the wanted lines, in their slots
+    noise: Counter  # its errors and warnings, by rule
 
 
-def _check(writer: _Writer, want: dict[int, str]) -> _Result:
-    """Compile the writer's text: does it store `want`, and what warnings does it give?"""
-    text = writer.text()
-    comp = compile_source(Source("decompiled.mcm", text), writer.model)
-    noise = Counter(d.rule.name for d in comp.report.items
-                    if d.severity in (Severity.ERROR, Severity.WARNING))
-    got = {} if comp.program is None else {
-        m.slot: mdtext.normal(m.line) for m in comp.program.macros.values()}
-    return _Result(text, got == want, noise)
+class _Search:
+    """The candidates the writer's choices make, each compiled once and compared with the
+    lines wanted; `best` is the last exact one that warns no more than the raw form.
 
+    Compiling is parsing, mostly: the language server's Rechecker parses each top-level
+    block once per distinct text, so a candidate that changes one slot re-parses one block.
+    """
 
-def _no_worse(new: Counter, old: Counter) -> bool:
-    return all(new[k] <= old[k] for k in new)
+    def __init__(self, writer: _Writer, want: dict[int, str]):
+        from mercmac.lsp.recheck import Rechecker
+
+        self.writer, self.want = writer, want
+        self.rechecker = Rechecker("decompiled.mcm", writer.model)
+        self.budget = COMPILES_PER_SLOT * len(want) + 8
+        self.seen: dict[str, _Result] = {}
+        self.normals: dict[str, str] = {}
+        self.best = self.result()
+
+    def result(self) -> _Result:
+        """Does the writer's text store `want`, and what errors and warnings does it give?"""
+        text = self.writer.text()
+        if text in self.seen:
+            return self.seen[text]
+        if self.budget <= 0:
+            return _Result(False, Counter())  # not tried: as good as refused
+        self.budget -= 1
+        comp = self.rechecker.check(text).compilation
+        noise = Counter(d.rule.name for d in comp.report.items
+                        if d.severity in (Severity.ERROR, Severity.WARNING))
+        got = {} if comp.program is None else {
+            m.slot: self.normal(m.line) for m in comp.program.macros.values()}
+        self.seen[text] = _Result(got == self.want, noise)
+        return self.seen[text]
+
+    def normal(self, line: str) -> str:
+        """mdtext.normal, once per line: most lines come back unchanged in every candidate."""
+        if line not in self.normals:
+            self.normals[line] = mdtext.normal(line)
+        return self.normals[line]
+
+    def better(self) -> bool:
+        """Whether the writer's choice is exact and warns no more; it is the best then."""
+        result = self.result()
+        if result.exact and all(result.noise[k] <= self.best.noise[k] for k in result.noise):
+            self.best = result
+            return True
+        return False
 
 
 def decompile(macros: dict[int, str], *, model: str | None = None, origin: str = "") -> str:
     """.mcm source whose `build` stores `macros` in the same slots (normalised lines)."""
     lines = read_lines(macros)
     writer = _Writer(lines, names(lines), model_of(lines, model))
-    want = {s: line.text for s, line in lines.items() if line.ops is not None}
     for s, line in lines.items():
         if line.ops is None:
             writer.why[s] = ("an empty line" if not line.text
@@ -265,78 +333,79 @@ def decompile(macros: dict[int, str], *, model: str | None = None, origin: str =
         if line.ops is None:
             stand_in[s] = Line(s, "WA0", (mdtext.parse_line("WA0").ops))
     checker = _Writer(stand_in, writer.names, writer.model)
-    want_check = {s: (line.text if line.ops is not None else "WA0") for s, line in lines.items()}
-    best = _check(checker, want_check)
-    if not best.exact:  # the raw form itself does not build back (cannot happen for valid lines)
+    search = _Search(checker, {s: line.text for s, line in stand_in.items()})
+    if not search.best.exact:  # the raw form itself does not build back (cannot happen for valid lines)
         return _finish(writer, origin)
     valid = [s for s in sorted(lines) if lines[s].ops is not None]
-    trial = dict.fromkeys(valid, FOLD)
-    checker.levels.update(trial)
-    first = _check(checker, want_check)
-    if first.exact and _no_worse(first.noise, best.noise):
-        best = first
-    else:
-        checker.levels.update(dict.fromkeys(valid, RAW))
+    checker.levels.update(dict.fromkeys(valid, FOLD))
+    if not search.better():  # everything folded where it can be
         checker.fold_ok = set()
-        for _ in range(2):  # twice: a caller can name its callee once that has a name
-            for s in valid:
-                for level in (FOLD, PLAIN, NATIVE):
-                    if level <= checker.levels[s]:
-                        break
-                    old = checker.levels[s]
-                    checker.levels[s] = level
-                    result = _check(checker, want_check)
-                    if result.exact and _no_worse(result.noise, best.noise):
-                        best = result
-                        break
-                    checker.levels[s] = old
-        best = _fold(checker, want_check, best)
+        if not search.better():  # every slot named, nothing folded
+            checker.levels.update(dict.fromkeys(valid, RAW))
+            _raise(search, valid)
+        _fold(search)
     for s in valid:
         if checker.levels[s] == RAW:
             writer.why[s] = "a named form of it builds another line or adds a warning"
-    _unpin(checker, want_check, best)
+    _unpin(search)
     writer.levels.update({s: checker.levels[s] for s in valid})
     writer.pinned, writer.fold_ok = checker.pinned, checker.fold_ok
     return _finish(writer, origin)
 
 
-def _fold(checker: _Writer, want: dict[int, str], best: _Result) -> _Result:
+def _raise(search: _Search, valid: list[int]) -> None:
+    """Write each slot as richly as the round trip allows, one slot at a time; then once
+    more the slots that call a slot named after they were tried (a call by name may do)."""
+    levels = search.writer.levels
+    for s in valid:
+        _raise_slot(search, s)
+    for s in valid:
+        if any(c > s and levels.get(c, RAW) != RAW for c in search.writer.lines[s].ems()):
+            _raise_slot(search, s)
+
+
+def _raise_slot(search: _Search, s: int) -> None:
+    levels = search.writer.levels
+    for level in (FOLD, PLAIN, NATIVE):
+        if level <= levels[s]:
+            return
+        old, levels[s] = levels[s], level
+        if search.better():
+            return
+        levels[s] = old
+
+
+def _fold(search: _Search) -> None:
     """Fold hoisted `when` macros into their callers one by one, where the slots allow."""
+    checker = search.writer
     for s in sorted(checker.lines):
         if checker.levels[s] == RAW or not s:
             continue
         checker.fold_ok.add(s)
-        before = dict(checker.levels)
-        result = _check(checker, want)
-        if result.exact and _no_worse(result.noise, best.noise):
-            best = result
-        else:
+        if not search.better():
             checker.fold_ok.discard(s)
-            checker.levels = before
-    return best
 
 
-def _unpin(checker: _Writer, want: dict[int, str], best: _Result) -> None:
-    """Drop the pins that the slot allocation makes needless (all at once, else one by one)."""
-    named = [s for s in checker.lines if s and checker.levels[s] != RAW]
-    checker.pinned.update(dict.fromkeys(named, False))
-    result = _check(checker, want)
-    if result.exact and _no_worse(result.noise, best.noise):
+def _unpin(search: _Search, group: list[int] | None = None) -> None:
+    """Drop the pins that the slot allocation makes needless: all at once, else by halves."""
+    checker = search.writer
+    if group is None:
+        group = [s for s in sorted(checker.lines, reverse=True) if s and checker.levels[s] != RAW]
+    checker.pinned.update(dict.fromkeys(group, False))
+    if search.better():
         return
-    checker.pinned.update(dict.fromkeys(named, True))
-    for s in reversed(named):
-        checker.pinned[s] = False
-        result = _check(checker, want)
-        if not (result.exact and _no_worse(result.noise, best.noise)):
-            checker.pinned[s] = True
+    checker.pinned.update(dict.fromkeys(group, True))
+    if len(group) > 1:
+        _unpin(search, group[:len(group) // 2])
+        _unpin(search, group[len(group) // 2:])
 
 
 def _finish(writer: _Writer, origin: str) -> str:
     from mercmac.fmt import format_text
 
     text = writer.text()
-    if origin:
-        text = f"// Read from {origin}.\n" + text
+    if origin:  # escaped: a name with a line end must not end the comment (issue 20, item 18)
+        text = f"// Read from {printable(origin)}.\n" + text
     try:
         return format_text(text)
     except Exception:  # a raw block that does not parse keeps the text as written

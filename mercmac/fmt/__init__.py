@@ -14,9 +14,12 @@ between tokens and the spelling of a few tokens, never the program:
 - a raw `[MCnn]` block is written as MMCRun saves it (MS176E §3.8.6, Example 4):
   `[MC05] BF,DP200,DI,DD200`, upper case, no blanks, the user's signs kept (`EM+9`).
   A block with a syntax error in its commands (`EMxx`) keeps them as written;
-- the file's line endings stay: CRLF when its first line ends in CRLF, else LF.
+- the file's line ends stay: every line ends with the file's most common line end
+  (LF, CRLF or CR: mercmac.source.LINE_END; the first one on a tie), LF when it has none.
 
 A file that does not parse is not formatted: `format_text` raises FormatError.
+`load` reads a file's bytes as text only when writing that text back gives the same bytes
+(issue 20): a byte its encoding does not have is an error, never a U+FFFD written back.
 """
 from __future__ import annotations
 
@@ -25,6 +28,7 @@ from typing import Iterator, NamedTuple
 
 from mercmac import mdtext
 from mercmac.errors import MercmacError
+from mercmac.source import LINE_END, Encoding, to_lf
 
 INDENT = "    "
 # MMCRun leaves three blank lines after its header comment (MS176E §3.8.6, Example 4).
@@ -52,52 +56,48 @@ class _Line(NamedTuple):
 
 
 def format_text(text: str) -> str:
-    """TEXT in the canonical layout; FormatError when it does not parse."""
-    newline = "\r\n" if _crlf(text) else "\n"
-    items = _items(text)
-    lines = list(_lines(items))
-    out = _render(lines)
-    formatted = out.replace("\n", newline)
-    _same_program(text, formatted)
-    return formatted
+    """TEXT in the canonical layout, with TEXT's line ends; FormatError when it does not parse."""
+    from mercmac.compiler.parse import paused_gc
+
+    newline = _line_end(text)
+    text = to_lf(text)
+    reads = _Reads()
+    with paused_gc():  # a token per few bytes, none in a cycle: see paused_gc
+        items = _items(text)
+        formatted = _render(list(_lines(items, reads)))
+        if formatted != text:  # the same text reads the same: the guard has nothing to see
+            _same_program(items, formatted, reads)
+    return formatted if newline == "\n" else formatted.replace("\n", newline)
 
 
-def _crlf(text: str) -> bool:
-    """True when the first line ends in CRLF (MMCRun is a Windows program)."""
-    end = text.find("\n")
-    return end > 0 and text[end - 1] == "\r"
+def _line_end(text: str) -> str:
+    """The file's line end: the most common of LF, CRLF and CR (the first on a tie), so a
+    stray CR does not turn a file around; LF when it has none."""
+    first = LINE_END.search(text)
+    if first is None:
+        return "\n"
+    crlf = text.count("\r\n")
+    counts = {"\n": text.count("\n") - crlf, "\r\n": crlf, "\r": text.count("\r") - crlf}
+    return max(counts, key=lambda end: (counts[end], end == first.group()))
 
 
 # -- tokens -------------------------------------------------------------------------------------
 
-def _tokens(text: str) -> tuple[list, list]:
-    """The parser's tokens and the skipped comments of TEXT; FormatError when it does not parse."""
-    from mercmac.compiler import parser_tables as lark
+def _items(text: str) -> list[tuple[str, str]]:
+    """The parser's tokens and the comments, in the order they stand (mercmac.compiler.parse);
+    FormatError when TEXT does not parse."""
+    from mercmac.compiler.parse import NotParsed, tokens
 
     if "\x00" in text:
         raise FormatError("the file holds NUL characters: not text")
-    comments: list = []
-    parser = lark.Lark_StandAlone(lexer_callbacks={"COMMENT": comments.append})
-    tokens = []
     try:
-        interactive = parser.parse_interactive(text + "\n")  # as mercmac.compiler.parse reads it
-        for token in interactive.iter_parse():
-            tokens.append(token)
-        interactive.feed_eof(tokens[-1] if tokens else None)
-    except lark.LarkError as e:
-        line, column = getattr(e, "line", "?"), getattr(e, "column", "?")
-        raise FormatError(f"syntax error at {line}:{column}; not formatted",
+        return tokens(text)
+    except NotParsed as e:
+        raise FormatError(f"syntax error at {e.line}:{e.column}; not formatted",
                           hint="`mercmac check` says what is wrong") from None
-    return tokens, comments
 
 
-def _items(text: str) -> list:
-    """Tokens and comments in the order they stand."""
-    tokens, comments = _tokens(text)
-    return sorted(tokens + comments, key=lambda t: t.start_pos)
-
-
-def _lines(items: list) -> Iterator[_Line | None]:
+def _lines(items: list, reads: _Reads) -> Iterator[_Line | None]:
     """The formatted lines; None for a blank line."""
     depth = 0
     line_depth = 0
@@ -106,19 +106,18 @@ def _lines(items: list) -> Iterator[_Line | None]:
     comment = ""
     leading = False
     started = False  # a line of code or comment has been written: blank lines count
-    for item in items:
-        kind = item.type
+    for kind, value in items:
         if kind == "_NL":
             if parts or comment:
-                yield _Line(line_depth, _join(parts), comment)
-            blanks = min(item.value.count("\n") - 1, MAX_BLANK_LINES)
+                yield _Line(line_depth, "".join(parts), comment)
+            blanks = min(value.count("\n") - 1, MAX_BLANK_LINES)
             if started:
                 yield from [None] * blanks
             parts, comment, previous = [], "", None
             continue
         started = True
         if kind == "COMMENT":
-            comment = item.value.rstrip()
+            comment = value.rstrip()
             if not parts:
                 line_depth = depth
             continue
@@ -128,14 +127,17 @@ def _lines(items: list) -> Iterator[_Line | None]:
         if leading:  # closing braces that open the line dedent it
             line_depth -= 1
         if kind == "RAW_LINE":
-            code, comment = _raw_line(item.value)
+            code, comment = _raw_line(value, reads)
             parts.append(code)
         else:
-            parts.append(_space(previous, kind) + _spell(kind, item.value))
-        depth += {"LBRACE": 1, "RBRACE": -1}.get(kind, 0)
+            parts.append(_space(previous, kind) + _spell(kind, value))
+        depth += _DEPTH.get(kind, 0)
         previous = kind
     if parts or comment:
-        yield _Line(line_depth, _join(parts), comment)
+        yield _Line(line_depth, "".join(parts), comment)
+
+
+_DEPTH = {"LBRACE": 1, "RBRACE": -1}
 
 
 def _space(previous: str | None, kind: str) -> str:
@@ -146,17 +148,13 @@ def _space(previous: str | None, kind: str) -> str:
 
 def _spell(kind: str, value: str) -> str:
     """A token as the canonical layout writes it."""
-    if kind in _SQUEEZE:
+    if kind in _SQUEEZE and (" " in value or "\t" in value):
         value = _BLANKS.sub("", value)
     if kind in _UPPER:
         value = value.upper()
     if kind == "DURATION":
         value = value.lower()  # units read in any case (mercmac.timespec)
     return value
-
-
-def _join(parts: list[str]) -> str:
-    return "".join(parts)
 
 
 def _render(lines: list[_Line | None]) -> str:
@@ -176,7 +174,16 @@ def _render(lines: list[_Line | None]) -> str:
 
 # -- raw blocks ---------------------------------------------------------------------------------
 
-def _raw_line(text: str) -> tuple[str, str]:
+class _Reads(dict):
+    """What raw blocks' commands say (`_read`), each text read once per file: the layout and
+    the guard read the same lines (a 1 MB line is read twice, not six times)."""
+
+    def __missing__(self, body: str):
+        self[body] = found = _read(body)
+        return found
+
+
+def _raw_line(text: str, reads: _Reads) -> tuple[str, str]:
     """A `[MCnn] ...` line as MMCRun writes it, and the comment that ends it."""
     header = _HEADER.match(text)
     rest = text[header.end():]
@@ -184,24 +191,34 @@ def _raw_line(text: str) -> tuple[str, str]:
     comment = (slash + comment).rstrip()
     slot = mdtext.number(header.group(1))
     head = f"[MC{slot:02d}]" if slot is not None else "[MC" + _BLANKS.sub("", header.group(1)) + "]"
-    body = _raw_body(body)
+    body = _raw_body(body, reads)
     return (f"{head} {body}" if body else head), comment
 
 
-def _raw_body(body: str) -> str:
+def _raw_body(body: str, reads: _Reads) -> str:
     """The commands upper case with their blanks dropped (`MR FAST` keeps one: `MRFAST` would
     be another word), each only where it reads the same; a line with a syntax error as written."""
     written = body.strip(mdtext.BLANKS)
-    if any(p.rule == "syntax" for p in mdtext.parse_line(body, stored=False).problems):
+    meaning = reads[body]
+    if meaning[1] or _placeholder(meaning[0]):
         return written  # the user's text, to be fixed by hand: `mercmac check` points into it
-    compact = ",".join(_raw_command(piece) for piece in body.split(","))
-    return compact if _read(compact) == _read(body) else written
+    compact = mdtext.canonical(body)  # what almost every line reads as: one pass over it
+    if reads[compact] != meaning:
+        compact = ",".join(_raw_command(piece, reads) for piece in body.split(","))
+    return compact if reads[compact] == meaning else written
 
 
-def _raw_command(piece: str) -> str:
+def _placeholder(commands: list) -> bool:
+    """A placeholder such as `EMxx` (MS176E Example 3): a syntax error that the command
+    table finds, not the lexer (mdtext.validate)."""
+    return any(f.rule == "syntax" for word, value in commands
+               for f in mdtext.validate(word, value, stored=False).findings)
+
+
+def _raw_command(piece: str, reads: _Reads) -> str:
     """One command of a raw block as MMCRun writes it: `em + 9` -> `EM+9`."""
     for candidate in (mdtext.canonical(piece), " ".join(piece.upper().split())):
-        if _read(candidate) == _read(piece):
+        if reads[candidate] == reads[piece]:
             return candidate
     return piece.strip(mdtext.BLANKS)
 
@@ -216,46 +233,44 @@ def _read(body: str):
 
 # -- the guard ----------------------------------------------------------------------------------
 
-def _same_program(before: str, after: str) -> None:
-    """The formatted text must read as the same tokens (blanks and line breaks aside), or
-    the formatter has a bug: refuse rather than change a program (black's --safe)."""
-    if _meaning(before) != _meaning(after):
+def _same_program(items: list, formatted: str, reads: _Reads) -> None:
+    """The formatted text must read as the same tokens (blanks and line breaks aside), each
+    already in its canonical spelling, or the formatter has a bug: refuse rather than change
+    a program (black's --safe)."""
+    if _meaning(items, reads) != _meaning(_items(formatted), reads, spell=False):
         raise FormatError("internal error: formatting would change the program; not formatted",
                           hint="please report this file")
 
 
-def _meaning(text: str) -> list:
-    tokens, comments = _tokens(text)
-    meaning = [c.value.rstrip() for c in comments]
-    for token in tokens:
-        if token.type == "_NL":
-            continue
-        if token.type == "RAW_LINE":
-            header = _HEADER.match(token.value)
-            body, _, comment = token.value[header.end():].partition("//")
-            meaning.append((mdtext.number(header.group(1)), _read(body), comment.rstrip()))
-        else:
-            meaning.append((token.type, _spell(token.type, token.value)))
-    return meaning
+def _meaning(items: list, reads: _Reads, spell: bool = True) -> tuple[list, list]:
+    """The comments, and each token in its canonical spelling (SPELL; formatted text has it
+    already) or, for a raw block, its slot, what its commands say and its comment."""
+    comments = [value.rstrip() for kind, value in items if kind == "COMMENT"]
+    code = [_raw_meaning(value, reads) if kind == "RAW_LINE" else
+            (kind, _spell(kind, value) if spell else value)
+            for kind, value in items if kind not in _LAYOUT]
+    return comments, code
+
+
+_LAYOUT = frozenset({"_NL", "COMMENT"})
+
+
+def _raw_meaning(line: str, reads: _Reads) -> tuple:
+    header = _HEADER.match(line)
+    body, _, comment = line[header.end():].partition("//")
+    return mdtext.number(header.group(1)), reads[body], comment.rstrip()
 
 
 # -- files --------------------------------------------------------------------------------------
 
-def load(data: bytes) -> tuple[str, str]:
-    """A file's text as `mercmac check` reads it, and the codec that writes it back as it was
-    (MMCRun writes Windows-1252; Notepad may save UTF-16 with a BOM)."""
-    from mercmac.source import decode
+def load(data: bytes) -> tuple[str, Encoding]:
+    """A file's text, and the encoding that writes it back as it was (MMCRun writes
+    Windows-1252; Notepad may save UTF-16 with a BOM); FormatError when writing the text
+    back would not give these bytes (a byte the encoding does not have)."""
+    from mercmac.source import EncodingError, decode_exact
 
-    text = decode(data)
-    for bom, codec in ((b"\xef\xbb\xbf", "utf-8-sig"), (b"\xff\xfe\x00\x00", "utf-32"),
-                       (b"\x00\x00\xfe\xff", "utf-32"), (b"\xff\xfe", "utf-16"),
-                       (b"\xfe\xff", "utf-16")):
-        if data.startswith(bom):
-            return text, codec
-    for codec in ("utf-8", "utf-16-le", "utf-16-be"):
-        try:
-            if data.decode(codec) == text:
-                return text, codec
-        except UnicodeDecodeError:
-            continue
-    return text, "cp1252"
+    try:
+        return decode_exact(data)
+    except EncodingError as e:
+        raise FormatError(f"{e.message}; not formatted",
+                          hint="fix that byte, or save the file in one encoding") from None

@@ -3,24 +3,38 @@
 Every open document is re-checked on open and on each change by the same checker as
 `mercmac check` (mercmac.lsp.recheck); the other features read that check's AST and
 lowered program (mercmac.lsp.symbols). LSP positions are 0-based, spans 1-based.
+Documents keep the editor's lines (mercmac.lsp.document), and messages are read so that
+a bad frame does not stop the server (mercmac.lsp.framing).
 """
 from __future__ import annotations
 
+import asyncio
+import logging
 import re
+import sys
+from typing import Callable
 
 from lsprotocol import types as t
+from pygls.exceptions import JsonRpcException
+from pygls.io_ import StdoutWriter
 from pygls.lsp.server import LanguageServer
 
 from mercmac import __version__
-from mercmac.diagnostics import Severity
-from mercmac.lsp import symbols
+from mercmac.diagnostics import Report, Severity
+from mercmac.errors import MercmacError
+from mercmac.lsp import framing, symbols
+from mercmac.lsp.document import Document, Documents
 from mercmac.lsp.recheck import Checked, Rechecker
-from mercmac.source import Source, Span
+from mercmac.render.report import capped
+from mercmac.source import LINE_END, Source, Span, split_lines
 
 _SEVERITY = {Severity.ERROR: t.DiagnosticSeverity.Error,
              Severity.WARNING: t.DiagnosticSeverity.Warning,
              Severity.INFO: t.DiagnosticSeverity.Information}
 _QUOTED = re.compile(r"'([^']+)'")
+# Diagnostics sent per document: an editor lists them all, and past a thousand it slows
+# down (a 2.5 MB file gave 288,000 of 700 bytes each, issue 20) while no one reads them.
+MAX_DIAGNOSTICS = 1000
 
 
 class MercmacServer(LanguageServer):
@@ -31,9 +45,58 @@ class MercmacServer(LanguageServer):
         self.checkers: dict[str, Rechecker] = {}
         self.checks: dict[str, Checked] = {}
         self.names: dict[str, tuple] = {}  # uri -> (macros, consts) of the last check that parsed
+        self.stale: set[str] = set()  # changed since their last check
+        self.say: Callable[[str], None] = lambda message: None
+
+    def start_io(self, stdin=None, stdout=None) -> None:
+        """Serve over stdio until the client says `exit` or the input ends; input that
+        ends inside a message is a MercmacError (the editor restarts the server)."""
+        self.protocol.set_writer(StdoutWriter(stdout or sys.stdout.buffer))
+        try:
+            problem = asyncio.run(framing.serve(stdin or sys.stdin.buffer, self.deliver,
+                                                self.say))
+        finally:
+            self.shutdown()
+        if problem:
+            raise MercmacError(f"language server: {problem}")
+
+    def deliver(self, data: dict) -> None:
+        """Hand one message to pygls; one it cannot take is said, and a request answered."""
+        try:
+            message = self.protocol.structure_message(data)
+        except JsonRpcException as e:  # pygls would drop it and leave the request unanswered
+            self.say(f"{data.get('method', 'a message')!s:.60}: {e.message}")
+            if "id" in data and "method" in data:  # pygls has no public way to answer it
+                self.protocol._send_response(data["id"], error=e.to_response_error())
+            return
+        if isinstance(message, dict):
+            self.say("a JSON object that is no JSON-RPC 2.0 message: skipped")
+            return
+        try:
+            self.protocol.handle_message(message)
+        except Exception as e:  # a bug in a handler: say it, serve the next message
+            self.say(f"{type(e).__name__}: {e}")
+
+    def changed(self, uri: str) -> None:
+        """Check `uri` once the messages read so far are handled: the edits that came while
+        a long check ran are checked once, at their last version."""
+        if not self.stale:
+            asyncio.get_running_loop().call_soon(self.check_stale)
+        self.stale.add(uri)
+
+    def check_stale(self) -> None:
+        """Check what changed; what a failure left unchecked is checked next."""
+        try:
+            while self.stale:
+                self.recheck(self.stale.pop())
+        finally:
+            if self.stale:
+                asyncio.get_running_loop().call_soon(self.check_stale)
 
     def recheck(self, uri: str) -> Checked:
-        text = self.workspace.get_text_document(uri).source
+        self.stale.discard(uri)
+        document = self.workspace.get_text_document(uri)
+        text = document.source
         checker = self.checkers.setdefault(uri, Rechecker(_name(uri)))
         try:
             checked = checker.check(text)
@@ -44,10 +107,14 @@ class MercmacServer(LanguageServer):
         if checked.module is not None:
             self.names[uri] = symbols.names(checked.items)
         self.text_document_publish_diagnostics(t.PublishDiagnosticsParams(
-            uri=uri, diagnostics=[_diagnostic(d) for d in checked.compilation.report.sorted()]))
+            uri=uri, version=document.version,
+            diagnostics=_diagnostics(checked.compilation.report)))
         return checked
 
     def checked(self, uri: str) -> Checked:
+        """The check of the document as it is now."""
+        if uri in self.stale:
+            return self.recheck(uri)
         return self.checks.get(uri) or self.recheck(uri)
 
 
@@ -75,6 +142,19 @@ def _spot(position: t.Position) -> tuple[int, int]:
     return position.line + 1, position.character + 1
 
 
+def _diagnostics(report: Report) -> list[t.Diagnostic]:
+    """The first MAX_DIAGNOSTICS of `report` as `check` orders them, and how many more."""
+    shown, left_out = capped(report.items, MAX_DIAGNOSTICS)
+    out = [_diagnostic(d) for d in shown]
+    for count in left_out.values():
+        out.append(t.Diagnostic(
+            range=t.Range(t.Position(0, 0), t.Position(0, 0)), source="mercmac",
+            severity=t.DiagnosticSeverity.Information,
+            message=f"{count:,} more diagnostics not shown (the first {MAX_DIAGNOSTICS:,} "
+                    "are); `mercmac check --max-diagnostics 0` lists them all"))
+    return out
+
+
 def _diagnostic(d) -> t.Diagnostic:
     """A diagnostic whose code is the rule's; `data` carries `mercmac explain` of it."""
     return t.Diagnostic(
@@ -87,19 +167,26 @@ def _diagnostic(d) -> t.Diagnostic:
 server = MercmacServer()
 
 
+@server.feature(t.INITIALIZE)
+def initialize(ls: MercmacServer, params: t.InitializeParams) -> None:
+    """Keep documents with the editor's lines: pygls has just made its workspace."""
+    ls.workspace.__class__ = Documents
+
+
 @server.feature(t.TEXT_DOCUMENT_DID_OPEN)
 def did_open(ls: MercmacServer, params: t.DidOpenTextDocumentParams) -> None:
-    ls.recheck(params.text_document.uri)
+    ls.changed(params.text_document.uri)
 
 
 @server.feature(t.TEXT_DOCUMENT_DID_CHANGE)
 def did_change(ls: MercmacServer, params: t.DidChangeTextDocumentParams) -> None:
-    ls.recheck(params.text_document.uri)
+    ls.changed(params.text_document.uri)
 
 
 @server.feature(t.TEXT_DOCUMENT_DID_CLOSE)
 def did_close(ls: MercmacServer, params: t.DidCloseTextDocumentParams) -> None:
     uri = params.text_document.uri
+    ls.stale.discard(uri)
     for table in (ls.checkers, ls.checks, ls.names):
         table.pop(uri, None)
     ls.text_document_publish_diagnostics(t.PublishDiagnosticsParams(uri=uri, diagnostics=[]))
@@ -140,7 +227,8 @@ def completion(ls: MercmacServer, params: t.CompletionParams) -> t.CompletionLis
     """Mnemonics with their argument, keywords, macro names and consts."""
     uri = params.text_document.uri
     document = ls.workspace.get_text_document(uri)
-    line = document.lines[params.position.line] if params.position.line < len(document.lines) else ""
+    lines = document.lines
+    line = lines[params.position.line] if params.position.line < len(lines) else ""
     before = line[:params.position.character]
     macros, consts = ls.names.get(uri) or symbols.names(ls.checked(uri).items)
     items = [t.CompletionItem(label=m, kind=t.CompletionItemKind.Function, detail="macro")
@@ -246,7 +334,7 @@ def document_symbols(ls: MercmacServer, params: t.DocumentSymbolParams) -> list[
 def formatting(ls: MercmacServer, params: t.DocumentFormattingParams) -> list[t.TextEdit] | None:
     """The whole document as `mercmac fmt` writes it (one edit), or no edit."""
     format_text = formatter()
-    document = ls.workspace.get_text_document(params.text_document.uri)
+    document: Document = ls.workspace.get_text_document(params.text_document.uri)
     text = document.source
     try:
         formatted = format_text(text)
@@ -254,9 +342,7 @@ def formatting(ls: MercmacServer, params: t.DocumentFormattingParams) -> list[t.
         return None
     if formatted == text:
         return []
-    lines = text.split("\n")
-    end = t.Position(len(lines) - 1, len(lines[-1]))
-    return [t.TextEdit(range=t.Range(t.Position(0, 0), end), new_text=formatted)]
+    return [t.TextEdit(range=t.Range(t.Position(0, 0), document.end()), new_text=formatted)]
 
 
 def formatter():
@@ -289,11 +375,13 @@ def code_actions(ls: MercmacServer, params: t.CodeActionParams) -> list[t.CodeAc
                 edit=t.WorkspaceEdit(changes={uri: [edit]})))
     if not symbols.has_target(checked.items, source.text):
         at = t.Position(symbols.target_line(source.text), 0)
+        found = LINE_END.search(source.text)
+        end = found.group() if found else "\n"  # the file's own line end, as an editor would
         for model in ("C-863", "C-663"):
             out.append(t.CodeAction(
                 title=f"Add `target {model}`", kind=t.CodeActionKind.QuickFix,
                 edit=t.WorkspaceEdit(changes={uri: [t.TextEdit(
-                    range=t.Range(at, at), new_text=f"target {model}\n")]})))
+                    range=t.Range(at, at), new_text=f"target {model}{end}")]})))
     return out
 
 
@@ -311,6 +399,28 @@ def _replacement(d, source: Source) -> tuple[t.TextEdit, str] | None:
     return t.TextEdit(range=_range(span), new_text=new), new
 
 
-def main() -> None:
+def main(say: Callable[[str], None]) -> None:
+    """Serve over stdio; `say` tells stderr (the editor's log) what went wrong, one line
+    each: pygls logs whole tracebacks, and the log wants the cause."""
+    def tell(message: str) -> None:
+        say(f"language server: {message}")
+
+    server.say = tell
+    logging.getLogger().addHandler(_Said(tell))
     server.start_io()
+
+
+class _Said(logging.Handler):
+    """pygls's and asyncio's warnings and errors, one line each through `say`."""
+
+    def __init__(self, say: Callable[[str], None]):
+        super().__init__(logging.WARNING)
+        self.say = say
+
+    def emit(self, record: logging.LogRecord) -> None:
+        text = split_lines(record.getMessage())[0][:300]
+        if record.exc_info and record.exc_info[1] is not None:
+            error = record.exc_info[1]
+            text += f": {type(error).__name__}: {error}"[:300]
+        self.say(text)
 

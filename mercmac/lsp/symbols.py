@@ -12,9 +12,10 @@ from mercmac.commands import COMMANDS, lookup
 from mercmac.compiler import ast
 from mercmac.compiler.parse import KEYWORDS  # noqa: F401  (completion and rename use them)
 from mercmac.compiler.program import Program
-from mercmac.source import Source, Span
+from mercmac.source import Source, Span, split_lines
 
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.]*\Z")
+_TARGET = re.compile(r"[ \t]*target\b")
 _DEFINES = {ast.MacroDef: re.compile(r"macro\s+([A-Za-z_][A-Za-z0-9_.]*)"),
             ast.Const: re.compile(r"const\s+([A-Za-z_][A-Za-z0-9_.]*)")}
 
@@ -173,12 +174,12 @@ def suggestion(message: str) -> str | None:
 def has_target(items: tuple, text: str) -> bool:
     if any(isinstance(i, ast.Target) for i in items):
         return True
-    return re.search(r"^[ \t]*target\b", text, re.MULTILINE) is not None
+    return any(_TARGET.match(line) for line in split_lines(text))
 
 
 def target_line(text: str) -> int:
     """The 0-based line where a `target` line goes: after the leading comments and blank lines."""
-    lines = text.split("\n")
+    lines = split_lines(text)
     n = 0
     while n < len(lines) and (not lines[n].strip() or lines[n].lstrip().startswith("//")):
         n += 1

@@ -1,9 +1,12 @@
-"""`mercmac history` as a table for people or JSON for programs."""
+"""`mercmac history` as a table for people or JSON for programs, and what `pull` and
+`decompile` say about a record. Every text a record holds is escaped as `check` escapes
+file names (report.printable): a name with a newline or an ESC sequence stays one cell."""
 from __future__ import annotations
 
 import json
 
 from mercmac.render.console import Line
+from mercmac.render.report import printable
 
 COLUMNS = ("time", "port", "address", "model", "firmware", "file", "macros")
 
@@ -30,6 +33,26 @@ def to_json(records) -> str:
         "backup": r.backup} for r in records]}, indent=2)
 
 
+def skipped_lines(skipped) -> list[Line]:
+    """One warning per history file that is no record, naming it and why."""
+    return [[("warning: ", "bold yellow"),
+             (f"{'cannot read the history folder' if s.folder else 'skipped the history file'} "
+              f"{printable(str(s.path))}: {printable(s.why)}", "")] for s in skipped]
+
+
+def label(record) -> str:
+    """'four-modes.mcm, flashed 2026-11-22 10:41 from /home/me/four-modes.mcm'."""
+    return (f"{printable(record.name)}, flashed {record.when.strftime('%Y-%m-%d %H:%M')} "
+            f"from {printable(record.file)}")
+
+
+def stale_text(recalled, instead: str) -> str:
+    """Why a record of exactly this build is not given back, and what is given instead."""
+    return (f"the recorded source of {label(recalled.stale)} no longer builds to what the "
+            f"controller holds ({recalled.why}): {instead}")
+
+
 def _row(r) -> tuple[str, ...]:
-    return (r.when.strftime("%Y-%m-%d %H:%M:%S"), r.port, str(r.address), r.model or "?",
-            r.firmware, r.file, str(len(r.macros)))
+    return (r.when.strftime("%Y-%m-%d %H:%M:%S"), printable(r.port), str(r.address),
+            printable(r.model or "?"), printable(r.firmware), printable(r.file),
+            str(len(r.macros)))

@@ -24,6 +24,12 @@ _HIDDEN = {c: f"\\x{c:02x}" for c in (*range(0x20), *range(0x7F, 0xA0))}
 _HIDDEN |= {c: f"\\u{c:04x}" for c in (0x2028, 0x2029, *range(0x200B, 0x2010),
                                          *range(0x202A, 0x202F), *range(0x2066, 0x206A), 0xFEFF)}
 _HIDDEN[0x09] = " "  # a tab shows as one space, so the caret stays under its column
+# A file name that is not UTF-8 holds its bytes as lone surrogates (os.fsdecode's
+# surrogateescape, U+DC80-U+DCFF for bytes 0x80-0xFF): shown as the byte, `\xff`; no
+# stream can write a lone surrogate as UTF-8 (issue 20).
+_SURROGATES = {c: f"\\u{c:04x}" for c in range(0xD800, 0xE000)}
+_SURROGATES |= {0xDC00 + b: f"\\x{b:02x}" for b in range(0x80, 0x100)}
+_HIDDEN |= _SURROGATES
 
 
 def printable(text: str) -> str:
@@ -203,15 +209,21 @@ def to_github(diagnostics: Iterable[Diagnostic], limit: int = MAX_JSON) -> str:
     out = []
     for d in kept:
         end_line, end_column = d.end
-        where = {"file": d.file.replace("\\", "/"), "line": d.span.line, "col": d.span.column,
+        where = {"file": _github_file(d.file), "line": d.span.line, "col": d.span.column,
                  "endLine": end_line, "endColumn": end_column,
                  "title": f"{d.rule.code} {d.rule.name}"}
         props = ",".join(f"{k}={str(v).translate(_GITHUB_PROPERTY)}" for k, v in where.items())
         out.append(f"::{_GITHUB_LEVEL[d.severity]} {props}::{d.message.translate(_GITHUB_DATA)}")
     for file, count in left_out.items():
-        out.append(f"::warning file={file.translate(_GITHUB_PROPERTY)}::{count} more "
-                   f"diagnostics not shown (--max-diagnostics)")
+        out.append(f"::warning file={_github_file(file).translate(_GITHUB_PROPERTY)}::{count} "
+                   f"more diagnostics not shown (--max-diagnostics)")
     return "".join(line + "\n" for line in out)
+
+
+def _github_file(file: str) -> str:
+    """A path as the repository names it; a byte that is not UTF-8 as `\\xff`, the one
+    thing a workflow command cannot carry (issue 20)."""
+    return file.replace("\\", "/").translate(_SURROGATES)
 
 
 _SARIF_LEVEL = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
@@ -255,14 +267,18 @@ def _sarif_result(d: Diagnostic, rule_index: int) -> dict:
 
 
 def _uri(file: str) -> str:
-    """A file as a URI: relative paths stay relative (to the repository, for GitHub)."""
+    """A file as a URI: relative paths stay relative (to the repository, for GitHub).
+
+    SARIF §3.4.3 takes RFC 3986 URIs: the name's file-system bytes, percent-encoded, so
+    that a name that is not UTF-8 (`b\\xff.mcm`) becomes `b%FF.mcm`, not an encoding error.
+    """
     import os
     from pathlib import Path
     from urllib.parse import quote
 
     if os.path.isabs(file):
-        return Path(file).as_uri()
-    return quote(file.replace("\\", "/"))
+        return Path(file).as_uri()  # file:///..., percent-encoded from os.fsencode too
+    return quote(os.fsencode(file.replace("\\", "/")))
 
 
 def rule_counts(diagnostics: Iterable[Diagnostic]) -> list[tuple[Diagnostic, int]]:

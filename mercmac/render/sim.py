@@ -15,7 +15,7 @@ from mercmac.sim.record import Folded, Recorder
 from mercmac.sim.simulate import Run
 
 ON, OFF = "●", "○"
-TEXT_LIMIT = 2000  # timeline lines shown as text; JSON keeps SPEC §5's 10,000
+TEXT_LIMIT = 2000  # lines of the story and of -v (-vv shows every line); JSON keeps 10,000
 
 
 def ms(t_us: float) -> int | float:
@@ -143,16 +143,26 @@ def _folded(fold: Folded) -> Line:
     return _fold_lines(fold, 2)[0][1]
 
 
+def _shown(kind: str, level: int) -> int:
+    """Lines a fold of a kind makes at a verbosity: a mode change always, an entry or exit
+    from `-v` on, a poll (its entry and its exit) only at `-vv` (`-v` sums them up)."""
+    if kind in record.MODES:
+        return 1
+    if kind == record.POLL:
+        return 2 if level >= 2 else 0
+    return 1 if level >= 1 else 0
+
+
 def _fold_lines(fold: Folded, level: int) -> list[tuple[int, Line]]:
     """(time, line) for a fold at a verbosity; a repeated one is dated at its last time."""
+    if not _shown(fold.kind, level):
+        return []
     if fold.kind in record.MODES:
         texts, style = [_mode_text(fold)], "bold blue"
     elif fold.kind == record.POLL:
         texts, style = [_flow_text(fold, True), _flow_text(fold, False)], "blue"
     else:
         texts, style = [_flow_text(fold, fold.kind == record.ENTRY)], "blue"
-    if level < (0 if fold.kind in record.MODES else 1 if fold.kind != record.POLL else 2):
-        return []
     if fold.count == 1:
         times = [fold.first_t, fold.last_t] if fold.kind == record.POLL else [fold.last_t]
         return [(t, _at(t) + [(text, style)]) for t, text in zip(times, texts)]
@@ -173,20 +183,20 @@ def _polls(folds: list[Folded]) -> list[tuple[int, Line]]:
     return [(t, _at(t) + [(text, "dim blue")])]
 
 
-def _stretch(folds: list[Folded], level: int) -> list[Line]:
-    """The macro flow between two other events, in time order."""
+def _stretch(folds: list[Folded], level: int) -> list[tuple[int, Line]]:
+    """The macro flow between two other events, (time, line) in time order."""
     dated = [pair for fold in folds for pair in _fold_lines(fold, level)]
     if level == 1:
         dated += _polls(folds)
-    return [line for _, line in sorted(dated, key=lambda pair: pair[0])]
+    return sorted(dated, key=lambda pair: pair[0])
 
 
 def _at(t_us: float) -> Line:
     return [(f"{clock(t_us):>16}  ", "dim")]
 
 
-def _story(events: list, level: int) -> Iterator[Line]:
-    """The shown lines: other events as they come, each stretch of folds sorted."""
+def _story(events: list, level: int) -> Iterator[tuple[int, Line]]:
+    """The shown lines, dated: other events as they come, each stretch of folds sorted."""
     folds: list[Folded] = []
     for event in events:
         if isinstance(event, Folded):
@@ -196,19 +206,41 @@ def _story(events: list, level: int) -> Iterator[Line]:
         folds = []
         line = event_line(event)
         if line is not None:
-            yield line
+            yield event.t, line
     yield from _stretch(folds, level)
 
 
 def timeline(rec: Recorder, level: int = 0) -> list[Line]:
-    """The timeline at a verbosity: 0 the story, 1 with macro entries and exits, 2 all."""
-    lines = list(islice(_story(rec.timeline, level), TEXT_LIMIT + 1))
-    hidden = max(len(lines) - TEXT_LIMIT, 0) + rec.dropped["timeline"]
-    lines = lines[:TEXT_LIMIT]
+    """The timeline at a verbosity: 0 the story, 1 with macro entries and exits, 2 all.
+
+    The story and `-v` stop after TEXT_LIMIT lines; `-vv` shows every line of the
+    recorded timeline. Either way the last line counts exactly the lines left out.
+    """
+    story = _story(rec.timeline, level)
+    dated = list(islice(story, TEXT_LIMIT if level < 2 else None))
+    cut = sum(1 for _ in story)  # what the text limit left out
+    hidden = cut + _unlisted(rec, level)
+    lines = [line for _, line in dated]
     if hidden:
-        more = plural(hidden, "more event") if not rec.dropped["timeline"] else "more events"
-        lines.append([(f"{'':>16}  ... {more} (see --format json)", "dim")])
+        lines.append(_left_out(hidden, dated[-1][0] if dated else 0, bool(cut), rec))
     return lines
+
+
+def _unlisted(rec: Recorder, level: int) -> int:
+    """The lines the entries past the recorder's cap would make at a verbosity."""
+    folds = sum(n * _shown(kind, level) for kind, n in rec.unlisted.items()
+                if kind not in (record.EVENT, record.POLLED))
+    return rec.unlisted[record.EVENT] + folds + (rec.unlisted[record.POLLED] if level == 1 else 0)
+
+
+def _left_out(hidden: int, after_us: int, cut: bool, rec: Recorder) -> Line:
+    """The closing line of a cut timeline: how many lines, after when, and where the rest is."""
+    where = [f"-vv shows {'more' if rec.dropped['timeline'] else 'every line'}"] if cut else []
+    if rec.dropped["timeline"]:
+        where.append(f"the timeline keeps the first {record.TIMELINE_CAP:,} entries; "
+                     "--vcd or --plot show the whole run")
+    return [(f"{'':>16}  ... {plural(hidden, 'more line')} after {clock(after_us)} "
+             f"({'; '.join(where)})", "dim")]
 
 
 def ending(run: Run) -> list[Line]:

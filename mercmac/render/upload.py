@@ -10,6 +10,7 @@ import sys
 from typing import IO
 
 from mercmac.render.console import Line, rich_console, use_colour, write_lines
+from mercmac.render.sim import plural
 
 _FATE_STYLE = {"written": "bold green", "erased": "bold yellow", "re-written last": "green",
                "unchanged": "dim", "kept (not in file)": "yellow"}
@@ -130,6 +131,8 @@ def _event_line(event) -> Line:
     style = {"retry": "bold yellow", "repair": "bold yellow", "backup": "bold"}.get(event.kind, "")
     if event.kind == "verified":
         return [(f"[{event.done}/{event.total}] ", "dim"), (event.text, "")]
+    if event.kind == "backup":
+        return [(f"backup of {plural(event.done, 'stored macro')}: {event.text}", style)]
     return [(event.text, style)]
 
 
@@ -146,6 +149,11 @@ def flash_summary(result, port: str) -> list[Line]:
         lines.append([("dry run: ", "bold yellow"), (f"nothing written; {_would(plan)}", "")])
         return lines + _restore_note(result)
     lines.append([("ok: ", "bold green"), (_outcome(plan), "")])
+    if result.unrecorded:  # the flash stands; only `pull` giving back this source is lost
+        lines.append([("warning: ", "bold yellow"),
+                      (f"the flash could not be recorded in the history ({result.unrecorded}): "
+                       f"`mercmac history` will not list it, nor `pull` give back this source",
+                       "")])
     if result.retried or result.repaired:
         again = ", ".join(f"MC{s:02d}" for s in result.retried + result.repaired)
         lines.append([("note: ", "bold yellow"), (f"needed a second write: {again} (check the cable)", "")])
@@ -166,9 +174,13 @@ def _restore_note(result) -> list[Line]:
     held = len(result.plan.after) - len(extra)
     slots = ", ".join(f"MC{s:02d}" for s in extra)
     return [[("note: ", "bold yellow"),
-             (f"this backup holds {held} macro{'s' if held != 1 else ''}; the controller also "
-              f"holds {slots}, which {'were' if not result.dry_run else 'would be'} kept: to "
+             (f"this backup holds {plural(held, 'macro')}; the controller also "
+              f"holds {slots}, which {_kept(len(extra), result.dry_run)}: to "
               f"restore the backup exactly, flash it again with --erase-unused", "")]]
+
+
+def _kept(n: int, dry_run: bool) -> str:
+    return "would be kept" if dry_run else "was kept" if n == 1 else "were kept"
 
 
 def completed_text(result) -> str:
@@ -221,7 +233,7 @@ def dry_run_lines(result, address: int | None, baud: int) -> list[Line]:
 def pulled_lines(pulled, port: str, address: int, output: str | None) -> list[Line]:
     v = pulled.identity.version
     where = f" into {output}" if output else ""
-    return [[("read ", ""), (f"{len(pulled.macros)} macros", "bold"),
+    return [[("read ", ""), (plural(len(pulled.macros), "macro"), "bold"),
              (f" from the {v.name} (firmware {v.firmware}) at address {address} on {port}{where}", "")]]
 
 

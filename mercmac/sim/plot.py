@@ -10,6 +10,7 @@ the SVG in a page that zooms and pans (render/plot_html.py).
 from __future__ import annotations
 
 import io
+import math
 import os
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass, field
@@ -26,6 +27,11 @@ BAND = 0.06  # a compressed stretch's width, as a share of the time drawn to sca
 CURVE = 16  # points per accelerating profile segment
 CAP = 200_000  # recorded changes; past this the plot stops (a marked cut) and the run goes on
 LANES = ("position", "buttons", "LEDs", "macro")
+# A lane of more bars than this is drawn at 1/3000 of the time axis, a quarter of a point
+# on the page: every bar has a 1-pt edge of its colour, which covers finer gaps at any
+# zoom (an SVG zooms its edges too); 36,000 macro changes cost a few thousand bars.
+LANE_STEPS = 3000
+LABEL_WIDTH = 0.03  # a band's label (two lines of 7 pt, turned, boxed): 3% of the time axis
 
 
 def check_target(path: str) -> None:
@@ -106,13 +112,15 @@ class PlotObserver:
                 self._enter(back, t)
             case ev.MoveStarted(_, _, target, _, segments):
                 self.trace.target.append((t, target))
+                self._mark(t)
                 self.segments, self.sampled_to = segments, t
             case ev.MoveEnded(_, _, position):
                 self.segments = ()
                 self.trace.position.append((t, float(position)))
             case ev.HomeDefined(_, position):
+                self._mark(t)
                 self.segments = ()
-                self.trace.position += [(t, self.trace.position[-1][1]), (t, float(position))]
+                self.trace.position.append((t, float(position)))
                 self.trace.target.append((t, position))
             case ev.HazardFound(_, rule):
                 self.trace.hazards.append((t, rule))
@@ -123,14 +131,25 @@ class PlotObserver:
                     self._pattern(last, t_to)
 
     def _follow(self, t: float) -> None:
-        """Position samples of the running profile up to t."""
+        """Position samples of the running profile up to t: CURVE points along each
+        accelerating segment, the ends of a straight one, however many events fall in it
+        (a 1-ms polling loop during a move would otherwise sample it every millisecond)."""
         for seg in self.segments:
-            a, b = max(seg.t0, self.sampled_to), min(seg.t1, t)
-            if a < b:
-                n = CURVE if seg.a else 1
-                self.trace.position += [(a + (b - a) * k / n, seg.x(a + (b - a) * k / n))
-                                        for k in range(n + 1)]
+            n = CURVE if seg.a else 1
+            step = seg.dt / n
+            if step > 0 and seg.t0 <= t and seg.t1 > self.sampled_to:
+                first = max(math.floor((self.sampled_to - seg.t0) / step) + 1, 0)
+                last = min(math.floor((t - seg.t0) / step), n)
+                self.trace.position += [(seg.t0 + k * step, seg.x(seg.t0 + k * step))
+                                        for k in range(first, last + 1)]
         self.sampled_to = max(self.sampled_to, t)
+
+    def _mark(self, t: float) -> None:
+        """The position at t itself, where the profile changes (a new move, a new home, the end)."""
+        x = next((seg.x(t) for seg in reversed(self.segments) if seg.t0 <= t),
+                 self.trace.position[-1][1])
+        if self.trace.position[-1] != (t, x):
+            self.trace.position.append((t, x))
 
     def _switch(self, since: dict, into: dict, n: int, on: bool, t: int) -> None:
         if on and n not in since:
@@ -154,7 +173,7 @@ class PlotObserver:
         if self.trace.cut_at is not None:
             return self.trace
         self._follow(t_us)
-        self.trace.position.append((t_us, self.trace.position[-1][1]))
+        self._mark(t_us)
         self.trace.target.append((t_us, self.trace.target[-1][1]))
         for since, into in ((self.held, self.trace.inputs), (self.lit, self.trace.outputs)):
             for n in list(since):
@@ -194,11 +213,14 @@ class TimeAxis:
         self.drawn.append(at + self.real[-1] - self.real[-2])
         self.real = [r / 1e6 for r in self.real]
         self.drawn = [d / 1e6 for d in self.drawn]
+        import numpy as np  # the plot extra's; a TimeAxis is made only to draw
+
+        self._xp, self._fp = np.array(self.real), np.array(self.drawn)  # once, not per call
 
     def __call__(self, t_us):
         import numpy as np
 
-        return np.interp(np.asarray(t_us, dtype=float) / 1e6, self.real, self.drawn)
+        return np.interp(np.asarray(t_us, dtype=float) / 1e6, self._xp, self._fp)
 
     def pieces(self) -> list[tuple[float, float, float, float]]:
         """(real from, real to, drawn from, drawn to) in seconds of the parts drawn to scale."""
@@ -227,7 +249,7 @@ class TimeAxis:
     def _at(self, seconds: float) -> float:
         import numpy as np
 
-        return float(np.interp(seconds, self.real, self.drawn))
+        return float(np.interp(seconds, self._xp, self._fp))
 
 
 def _merged(skips: list, actions: list) -> list:
@@ -286,7 +308,7 @@ def figure(trace: Trace, title: str = ""):
     _bars(axes[2], trace.outputs, [1, 2, 3, 4], axis, "tab:orange", "LEDs")
     _macros(axes[3], trace.macros, axis)
     for ax in axes:
-        _skipped(ax, trace, axis, label=ax is axes[0])
+        _skipped(ax, axis, label=ax is axes[0])
     where, text = axis.ticks()
     axes[-1].set_xticks(where, text)
     axes[-1].set_xlim(0, axis.drawn[-1])
@@ -322,39 +344,105 @@ def _position(ax, trace: Trace, axis: TimeAxis) -> None:
 
 def _bars(ax, lanes: dict, rows: list, axis: TimeAxis, color: str, name: str) -> None:
     for y, n in enumerate(rows):
-        spans = [(float(axis(a)), float(axis(b) - axis(a))) for a, b in lanes.get(n, ())]
-        ax.broken_barh(spans, (y + 0.15, 0.7), color=color)
+        spans = _spans(axis, lanes.get(n, ()))
+        _lane(ax, spans, [color] * len(spans), (y + 0.15, 0.7), axis)
     ax.set_yticks([y + 0.5 for y in range(len(rows))], [str(n) for n in rows], fontsize=8)
     ax.set_ylim(len(rows), 0)
     ax.set_ylabel(name)
     ax.grid(axis="x", alpha=0.3)
 
 
+def _spans(axis: TimeAxis, pairs) -> list[tuple[float, float]]:
+    """(drawn start, drawn width) of (t0, t1, ...) in us, all mapped in one call."""
+    if not pairs:
+        return []
+    x = axis([pair[:2] for pair in pairs])
+    return list(zip(x[:, 0].tolist(), (x[:, 1] - x[:, 0]).tolist()))
+
+
+def _lane(ax, spans: list, colors: list, height: tuple, axis: TimeAxis) -> None:
+    """Bars in one collection (one per bar makes matplotlib rescale the axes each
+    time: quadratic)."""
+    spans, colors = _drawable(spans, colors, axis)
+    ax.broken_barh(spans, height, color=colors)
+
+
+def _drawable(spans: list, keys: list, axis: TimeAxis) -> tuple[list, list]:
+    """A lane of more than LANE_STEPS bars drawn no finer than that; others as they are."""
+    if len(spans) <= LANE_STEPS:
+        return spans, keys
+    return _coarse(spans, keys, (axis.drawn[-1] or 1.0) / LANE_STEPS)
+
+
+def _coarse(spans: list, keys: list, step: float) -> tuple[list, list]:
+    """The spans and keys of a lane drawn `step` fine: bars of one key less than `step`
+    apart joined, and a run of bars narrower than `step` joined into a block about `step`
+    wide, split between its keys in proportion (two macros taking turns stay two colours)."""
+    blocks: list[list] = []  # [x0, x1, {key: width covered}]
+    for (x, w), key in zip(spans, keys):
+        last = blocks[-1] if blocks else None
+        if last and x - last[1] < step and (
+                last[2].keys() == {key} or (w < step and last[1] - last[0] < step)):
+            last[1] = max(last[1], x + w)
+            last[2][key] = last[2].get(key, 0.0) + w
+        else:
+            blocks.append([x, x + w, {key: w}])
+    out_spans, out_keys = [], []
+    for x0, x1, widths in blocks:
+        total, at = sum(widths.values()) or 1.0, x0
+        for key, w in widths.items():
+            out_spans.append((at, (x1 - x0) * w / total))
+            out_keys.append(key)
+            at += (x1 - x0) * w / total
+    return out_spans, out_keys
+
+
 def _macros(ax, macros: list, axis: TimeAxis) -> None:
     import matplotlib
 
+    tab20 = matplotlib.colormaps["tab20"]
     names = sorted({label for *_, label in macros})
-    colors = matplotlib.colormaps["tab20"]
+    color = {label: tab20(i % 20) for i, label in enumerate(names)}
+    spans = _spans(axis, macros)
+    _lane(ax, spans, [color[label] for *_, label in macros], (0.1, 0.8), axis)
     total = axis.drawn[-1] or 1.0
-    for a, b, label in macros:
-        x0, x1 = float(axis(a)), float(axis(b))
-        ax.broken_barh([(x0, x1 - x0)], (0.1, 0.8), color=colors(names.index(label) % 20))
-        if x1 - x0 > total * 0.035:
-            ax.text((x0 + x1) / 2, 0.5, label, ha="center", va="center", fontsize=7, clip_on=True)
+    for (x0, width), (*_, label) in zip(spans, macros):
+        if width > total * 0.035:
+            ax.text(x0 + width / 2, 0.5, label, ha="center", va="center", fontsize=7, clip_on=True)
     ax.set_yticks([])
     ax.set_ylim(0, 1)
     ax.set_ylabel("macro", rotation=0, ha="right", va="center")
     ax.grid(axis="x", alpha=0.3)
 
 
-def _skipped(ax, trace: Trace, axis: TimeAxis, label: bool) -> None:
-    for a, b in axis.stretches:
-        x0, x1 = float(axis(a)), float(axis(b))
-        ax.axvspan(x0, x1, facecolor="white", edgecolor="gray", hatch="///", lw=0, zorder=3)
-        if label:
-            ax.text((x0 + x1) / 2, 0.5, f"{span(b - a)}\nfast-forwarded",
-                    transform=ax.get_xaxis_transform(), ha="center", va="center", fontsize=7,
-                    rotation=90, zorder=4, bbox={"facecolor": "white", "edgecolor": "gray"})
+def _skipped(ax, axis: TimeAxis, label: bool) -> None:
+    """The compressed stretches hatched across the axes: one path of many parts, hatched
+    once (hatching each band on its own costs milliseconds a band)."""
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path
+
+    bands = _spans(axis, axis.stretches)
+    if bands:
+        drawn, _ = _drawable(bands, [None] * len(bands), axis)
+        parts = [Path([(x, 0), (x, 1), (x + w, 1), (x + w, 0), (x, 0)], closed=True)
+                 for x, w in drawn]
+        # an artist, not a patch: the time axis is set, and its limits would walk every part
+        ax.add_artist(PathPatch(Path.make_compound_path(*parts), transform=ax.get_xaxis_transform(),
+                                facecolor="white", edgecolor="gray", hatch="///", lw=0, zorder=3))
+    if label:
+        _band_labels(ax, axis, bands)
+
+
+def _band_labels(ax, axis: TimeAxis, bands: list) -> None:
+    """Each band's real length, where the label does not cover the one before it."""
+    total, placed = axis.drawn[-1] or 1.0, -math.inf
+    for (x, w), (a, b) in zip(bands, axis.stretches):
+        if x + w / 2 - placed < total * LABEL_WIDTH:
+            continue
+        placed = x + w / 2
+        ax.text(placed, 0.5, f"{span(b - a)}\nfast-forwarded",
+                transform=ax.get_xaxis_transform(), ha="center", va="center", fontsize=7,
+                rotation=90, zorder=4, bbox={"facecolor": "white", "edgecolor": "gray"})
 
 
 def write(path: str, trace: Trace, title: str = "") -> None:

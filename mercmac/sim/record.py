@@ -8,10 +8,13 @@ loop makes by the thousand, are folded: between two other events each (macro,
 what happened) appears once with a count. A macro entered only to fail its
 first `XN`/`XF` and leave is a poll; entering a macro with a tail `EM` (a
 `goto`) or one that loops for long is a mode change. The timeline shows the
-three apart (render/sim.py: default, `-v`, `-vv`).
+three apart (render/sim.py: default, `-v`, `-vv`). Past its cap the timeline
+is only counted, by kind of entry, so that the text can say exactly how many
+lines it leaves out at each verbosity.
 """
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
 from itertools import islice
 
@@ -21,12 +24,14 @@ from mercmac.vm import fastforward as ff
 from mercmac.vm.opcodes import Opcode
 
 CAP = 10_000  # SPEC §5: reports, output changes and events beyond this are counted, not listed
-TIMELINE_CAP = 100_000
+TIMELINE_CAP = 100_000  # timeline entries listed; the rest are counted in Recorder.unlisted
 LONG_LOOP = 1000  # an RP repeating this often or more makes a macro a mode, not a step
 
 ENTRY, POLL, LEFT = "entry", "poll", "left"
 START, GOTO, LOOP = "start", "goto", "loop"  # mode changes: power-on or host, tail EM, long loop
 MODES = (START, GOTO, LOOP)
+EVENT = "event"  # an unlisted entry that is not a fold: one line at every verbosity
+POLLED = "polled"  # a stretch between two events with unlisted polls (one line at `-v`)
 
 
 @dataclass(slots=True)
@@ -67,12 +72,14 @@ class Recorder:
         self.trace: list[ev.Executed] = []
         self.events: list = []  # every event but Executed, unfolded, for JSON (SPEC §5 `events`)
         self.dropped = {"reports": 0, "outputs": 0, "timeline": 0, "trace": 0, "events": 0}
+        self.unlisted: Counter = Counter()  # timeline entries past TIMELINE_CAP, by kind
         self.ended_at: int | None = None
         self._folds: dict[tuple, Folded] = {}
         self._gotos: set[tuple[int, int]] = set()
         self._loops: set[int] = set()
         self._current: int | None = None  # the running macro's slot, as the events tell it
         self._entered: Folded | None = None  # the entry just made, while nothing else happened
+        self._polled = False  # this stretch (since the last other event) has a poll
 
     def know(self, chunks: dict) -> None:
         """Learn the program's gotos and long loops (the machine's assembled chunks)."""
@@ -98,7 +105,8 @@ class Recorder:
             self._skipped(event)
         self._folds.clear()
         self._entered = None
-        self._keep(self.timeline, event, "timeline")
+        self._polled = False
+        self._log(event)
 
     def _skipped(self, skip: ev.FastForwarded) -> None:
         """The reports and output changes of skipped passes: listed up to the cap, counted."""
@@ -118,6 +126,19 @@ class Recorder:
             into.append(event)
         else:
             self.dropped[what] += 1
+
+    def _log(self, entry) -> None:
+        """Onto the timeline; past its cap counted by kind, since what an entry shows
+        depends on the verbosity (a poll is two lines at `-vv`, none by default)."""
+        kind = entry.kind if isinstance(entry, Folded) else EVENT
+        first_poll = kind == POLL and not self._polled
+        self._polled = self._polled or kind == POLL
+        if len(self.timeline) < TIMELINE_CAP:
+            self.timeline.append(entry)
+            return
+        self.dropped["timeline"] += 1
+        self.unlisted[kind] += 1
+        self.unlisted[POLLED] += first_poll
 
     def _flow(self, event: ev.MacroEntered | ev.MacroLeft) -> None:
         entered, self._entered = self._entered, None
@@ -145,7 +166,7 @@ class Recorder:
         fold = self._folds.get(key)
         if fold is None:
             fold = self._folds[key] = Folded(event, 0, event.t, kind, first_t)
-            self._keep(self.timeline, fold, "timeline")
+            self._log(fold)
         fold.count += 1
         fold.last_t = event.t
         return fold
@@ -158,5 +179,6 @@ class Recorder:
         del self._folds[(fold.kind, fold.event.slot, "")]
         if self.timeline and self.timeline[-1] is fold:
             self.timeline.pop()
-        else:
+        else:  # past the cap: it was counted, not listed
             self.dropped["timeline"] -= 1
+            self.unlisted[ENTRY] -= 1

@@ -5,10 +5,13 @@ what to check; nothing in this module writes a macro.
 """
 from __future__ import annotations
 
+import os
+import stat
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Callable, Iterator
 
+from mercmac import outfile
 from mercmac.commands import MODELS
 from mercmac.upload.controller import BadReply, Controller, ControllerError, Flood, LinkLost, NoAnswer
 from mercmac.upload.errors import PortError, Refused
@@ -30,12 +33,35 @@ def open_controller(port: str, address: int = 0, *, baud: int = DEFAULT_BAUD,
                     timing: Timing = Timing(),
                     tap: Callable[[str, bytes], None] | None = None) -> Iterator[Controller]:
     """A Controller on a freshly opened port, closed again on the way out."""
+    not_a_port = _not_a_port(port)
+    if not_a_port:
+        raise PortError(f"cannot open {port}: {not_a_port}",
+                        hint="`mercmac ports` lists the serial ports of this computer")
     try:
         transport = Transport(port, baud, timing, tap)
     except PortUnavailable as e:
-        raise PortError(str(e), hint=_port_hint(str(e))) from None
+        said = str(e)
+        if "inappropriate ioctl" in said.lower():  # ENOTTY: a device without a line (/dev/null)
+            said = f"cannot open {port}: it is a device, but not a serial port"
+        raise PortError(said, hint=_port_hint(said)) from None
     with transport:
         yield Controller(transport, address)
+
+
+def _not_a_port(port: str) -> str:
+    """Why PORT cannot be a serial port, when it names a file that is no device (a regular
+    file, a FIFO, a folder): looked at, never opened, so a FIFO cannot hold the open up.
+    '' when it may be one (a device, a URL, a name the system has no file for: COM3)."""
+    if "://" in port:
+        return ""
+    try:
+        mode = os.stat(port).st_mode
+    except (OSError, ValueError):
+        return ""  # opening it says what is wrong
+    if stat.S_ISCHR(mode):
+        return ""
+    what = "a regular file" if stat.S_ISREG(mode) else outfile.kind(mode)
+    return f"it is {what}, not a serial port"
 
 
 def identify(controller: Controller) -> Identity:

@@ -30,8 +30,8 @@ class Event:
     """Something to show while flashing; `done`/`total` drive a progress bar."""
 
     kind: str  # backup, plan, step, verified, retry, repair, reset
-    text: str
-    done: int = 0
+    text: str  # backup: the backup's path
+    done: int = 0  # backup: how many macros it holds
     total: int = 0
     sent: int = 0  # bytes of the plan's steps sent so far (commands and read-backs)
     size: int = 0  # bytes of all the plan's steps: with `sent`, a rate and the time left
@@ -62,6 +62,7 @@ class FlashResult:
     retried: list[int] = field(default_factory=list)
     repaired: list[int] = field(default_factory=list)
     recorded: Path | None = None  # the history record of this flash (mercmac.upload.history)
+    unrecorded: str = ""  # why that record could not be written ('' when it was)
 
     restoring: bool = False  # the file is a backup (pull or flash wrote it)
 
@@ -167,8 +168,12 @@ def _record(controller: Controller, identity: Identity, compiled: Compilation,
                               file=compiled.source.name, source=compiled.source.text,
                               build=compiled.program.md_lines(),
                               backup_path=result.backup)
-    except (OSError, outfile.OutputError):
-        return None  # the flash is done and verified; a history that cannot be written is no failure
+    except (OSError, outfile.OutputError) as e:
+        # the flash is done and verified; a history that cannot be written is no failure,
+        # but `pull` will not give this source back: the summary says so (issue 20, item 17)
+        result.unrecorded = (e.message if isinstance(e, outfile.OutputError)
+                             else f"{history.folder()}: {outfile.reason(e)}")
+        return None
 
 
 def _is_backup(path: str) -> bool:
@@ -202,7 +207,8 @@ def flash(controller: Controller, identity: Identity, program: Program,
         if options.dry_run:
             return result
         result.backup = _save_backup(controller, identity, stored, options.backup)
-        notify(Event("backup", f"backup of {len(stored)} stored macros: {result.backup}"))
+        # words are render.upload's: the count of macros backed up, and where
+        notify(Event("backup", str(result.backup), len(stored)))
     except ControllerError as e:
         raise refusal(controller, e) from None
     except KeyboardInterrupt:

@@ -1,0 +1,79 @@
+"""The server's copy of an open document, with lines where the editor has them.
+
+pygls cuts a document with `str.splitlines`, which also ends a line at \\f, \\v, \\x1c-\\x1e,
+U+0085, U+2028 and U+2029. Editors end lines at LF, CRLF and CR only (LSP specification,
+"Text Documents"), so an edit sent for one line landed on another and the copy drifted
+from the editor's (issue 20). A Document cuts lines with mercmac.source.LINE_END, and
+turns LSP positions into offsets in one place (`offset_at`), counting characters in the
+units the client and server agreed on (UTF-16 unless said otherwise).
+"""
+from __future__ import annotations
+
+from lsprotocol import types as t
+from pygls.workspace import TextDocument, Workspace
+
+from mercmac.source import LINE_END, split_lines
+
+
+class Document(TextDocument):
+    """A pygls TextDocument whose lines end at LF, CRLF or CR, as the editor's do."""
+
+    _cut: tuple[str, list[int], list[str]] | None = None  # (source, line starts, lines)
+
+    def _lines_of_source(self) -> tuple[list[int], list[str]]:
+        """Where each line starts, and each line without its end; once per version."""
+        source = self.source
+        if self._cut is None or self._cut[0] is not source:
+            starts = [0, *(m.end() for m in LINE_END.finditer(source))]
+            self._cut = (source, starts, split_lines(source))
+        return self._cut[1], self._cut[2]
+
+    @property
+    def lines(self) -> tuple[str, ...]:
+        """The lines with their ends, as pygls's own methods expect them."""
+        source = self.source
+        starts, _ = self._lines_of_source()
+        ends = starts[1:] + ([len(source)] if starts[-1] < len(source) else [])
+        return tuple(source[a:b] for a, b in zip(starts, ends))
+
+    def offset_at(self, position: t.Position) -> int:
+        """The index into `source` of an LSP position: a character past the end of its
+        line means the end of that line, a line past the last one the end of the text."""
+        starts, lines = self._lines_of_source()
+        if position.line >= len(starts):
+            return len(self.source)
+        line = lines[position.line]
+        return starts[position.line] + self._index(line, position.character)
+
+    def end(self) -> t.Position:
+        """The position just past the last character."""
+        starts, lines = self._lines_of_source()
+        return t.Position(len(lines) - 1, self.position_codec.client_num_units(lines[-1]))
+
+    def _index(self, line: str, units: int) -> int:
+        """How many characters of `line` the first `units` client units cover."""
+        if line.isascii():  # one unit per character in UTF-8, UTF-16 and UTF-32 alike
+            return min(units, len(line))
+        count = self.position_codec.client_num_units
+        used = 0
+        for index, character in enumerate(line):
+            if used >= units:
+                return index
+            used += count(character)
+        return len(line)
+
+    def _apply_incremental_change(self, change: t.TextDocumentContentChangePartial) -> None:
+        """Replace the text between the change's two positions, as the editor did."""
+        start, end = self.offset_at(change.range.start), self.offset_at(change.range.end)
+        source = self.source
+        self._source = source[:start] + change.text + source[max(start, end):]
+
+
+class Documents(Workspace):
+    """pygls's workspace, keeping each open document as a Document."""
+
+    def _create_text_document(self, doc_uri: str, source: str | None = None,
+                              version: int | None = None,
+                              language_id: str | None = None) -> Document:
+        return Document(doc_uri, source=source, version=version, language_id=language_id,
+                        sync_kind=self._sync_kind, position_codec=self.position_codec)
