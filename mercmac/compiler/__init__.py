@@ -26,17 +26,17 @@ class Compilation(NamedTuple):
 
 def compile_source(source: Source, target: str | None = None) -> Compilation:
     """Compile text; `target` (from --target) overrides the file's `target` line."""
-    from mercmac.compiler.ast_builder import build
+    from mercmac.compiler.ast_builder import parse_module
     from mercmac.compiler.checks import check_module
     from mercmac.compiler.program_checks import check_program
     from mercmac.compiler.lower import lower
-    from mercmac.compiler.parse import parse_partial, paused_gc
+    from mercmac.compiler.parse import paused_gc
 
     report = Report(source.name)
-    parsed = parse_partial(source.text, report)
+    parsed = parse_module(source.text, report)
     if parsed.tree is None:
         return Compilation(source, report, None)
-    module = build(parsed.tree)
+    module = parsed.tree
     model = target.upper() if target else None
     if parsed.failed:
         _check_partial(source, module, parsed.broken, report, model)

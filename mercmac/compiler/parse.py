@@ -9,9 +9,14 @@ holds (issue 7).
 
 The parser reads text with every line end written LF (mercmac.source.to_lf): a CR or
 CRLF ends a line as LF does, with the same line and column numbers (issue 20).
+
+A file that parses is read by `read`, which runs grammar.lark's own tables and builds the
+AST as it goes, several times faster than lark's parse and tree (issue 20: 67-81 s to check
+a 500 KB line); lark's parser reads the others, as only it recovers from errors.
 """
 from __future__ import annotations
 
+import bisect
 import contextlib
 import functools
 import gc
@@ -132,12 +137,99 @@ def _shift(stack: list, r: _Recognizer, kind: str) -> bool:
         if shift:
             stack.append(arg)
             return True
-        size, origin = arg
+        size, origin, _ = arg
         if size:
             del stack[-size:]
         stack.append(r.table[stack[-1]][origin][1])
         if stack[-1] == r.end:
             return True
+
+
+class Lexeme(NamedTuple):
+    """A token as the AST builder gets it, from `read` or from lark's tree (ast_builder)."""
+
+    type: str  # its terminal in grammar.lark
+    value: object  # its text; a RawLine for a raw block
+    span: Span
+
+
+_LF = re.compile("\n")
+
+
+def read(text: str, rules: dict):
+    """What `rules` make of TEXT read bottom-up by grammar.lark's automaton, as `tokens`
+    reads it: lark's parse, tree and Transformer in one pass, several times faster (issue
+    20). None where TEXT does not read cleanly (a syntax error, a raw block whose commands
+    do not read, blocks nested beyond MAX_NESTING, a NUL): `parse_partial` says why.
+
+    `rules` maps each node of lark's tree to a function of the node's span and children,
+    as a Transformer of lark's tree with positions gets them: the kept tokens (as Lexemes)
+    and nodes, `_rule`s spliced in; a node spans its first token to its last, keywords and
+    `_NL` included. Children wait in `out`; each stack entry records where its tokens start
+    in the text and in `out`. One loop, kept whole: it runs once per token.
+    """
+    r = _recognizer()
+    lexers, table, ignored, kept, where = r.lexers, r.table, r.ignored, r.kept, bisect.bisect_right
+    new = tuple.__new__  # a NamedTuple without its Python-level __new__: half the cost
+    text = to_lf(text) + "\n"  # as `parse_partial` reads it: the last line ends
+    if "\x00" in text:
+        return None
+    lines = [0, *(m.end() for m in _LF.finditer(text))]  # where each line starts
+    states, starts, marks, out = [r.start], [0], [0], []
+    pos, size, depth, last, start, kind, value = 0, len(text), 0, 0, 0, "", ""
+    while kind != "$END":
+        if pos < size:
+            match, keywords = lexers[states[-1]]
+            m = match(text, pos)
+            if m is None:
+                return None
+            kind = m.lastgroup
+            pos = m.end()
+            if kind in ignored:
+                continue
+            value, start = m.group(kind), m.start(kind)
+            if kind in keywords:  # a NAME that is a keyword (lark's UnlessCallback)
+                kind = keywords[kind].get(value, kind)
+        else:
+            kind = "$END"
+        action = table[states[-1]].get(kind)
+        while action is not None and not action[0]:  # the reductions this token implies
+            n, origin, node = action[1]
+            first = len(states) - n  # its first entry becomes the rule's (n > 0: _node)
+            if n > 1:  # (one symbol, the common case, only changes its entry's state)
+                del states[first + 1:], starts[first + 1:], marks[first + 1:]
+            states[first] = table[states[first - 1]][origin][1]
+            if node is not None:
+                begin, mark = starts[first], marks[first]
+                line, end = where(lines, begin), where(lines, last)
+                column, end_column = begin - lines[line - 1] + 1, last - lines[end - 1] + 1
+                span = new(Span, (line, column, end, end_column))
+                children = out[mark:]
+                del out[mark:]
+                out.append(rules[node](span, children))
+            action = table[states[-1]].get(kind)
+        if action is None:
+            return out[0] if kind == "$END" and states[-1] == r.end else None
+        states.append(action[1])
+        starts.append(start)
+        marks.append(len(out))
+        last = pos
+        if kind in kept:
+            if kind == "RAW_LINE":
+                value = _read_raw(value)
+                if value.problems:
+                    return None
+            line = where(lines, start)
+            column = start - lines[line - 1] + 1
+            span = new(Span, (line, column, line, column + pos - start))
+            out.append(new(Lexeme, (kind, value, span)))
+        elif kind == "LBRACE":  # deeper than the nesting limit: parse_partial reports it
+            depth += 1
+            if depth > MAX_NESTING + 1:  # a macro's block, and one per nested block
+                return None
+        elif kind == "RBRACE":
+            depth -= 1
+    return None
 
 
 def _not_parsed(text: str, pos: int) -> NotParsed:
@@ -147,14 +239,16 @@ def _not_parsed(text: str, pos: int) -> NotParsed:
 
 
 class _Recognizer(NamedTuple):
-    """grammar.lark's automaton as plain tables (see `tokens`)."""
+    """grammar.lark's automaton as plain tables (see `tokens` and `read`)."""
 
     lexers: dict  # state -> (match function of its terminals, {word kind: {keyword: kind}})
-    table: dict  # state -> {kind: (True, state) to shift, or (False, (size, rule)) to reduce}
+    table: dict  # state -> {kind: (True, state) to shift, or (False, (size, rule, node)) to
+    # reduce; `node` is the name of the tree node the rule makes, None for a `_rule`}
     start: int
     end: int
     ignored: frozenset  # terminals the parser skips: blanks and comments
     blanks: frozenset  # of those, the ones `tokens` leaves out
+    kept: frozenset  # terminals a tree keeps (not `_NL`, not keywords and punctuation)
 
 
 _RECOGNIZER: list[_Recognizer] = []
@@ -167,14 +261,46 @@ def _recognizer() -> _Recognizer:
         ignored = frozenset(frontend.lexer_conf.ignore)
         parse_table = frontend.parser.parser.parse_table
         table = {state: {kind: (True, arg) if action is lark.Shift else
-                         (False, (len(arg.expansion), arg.origin.name))
+                         (False, (len(arg.expansion), arg.origin.name, _node(arg)))
                          for kind, (action, arg) in actions.items()}
                  for state, actions in parse_table.states.items()}
         _RECOGNIZER.append(_Recognizer(
-            {state: _lexer(lexer) for state, lexer in frontend.lexer.lexers.items()}, table,
+            _Lexers(frontend.lexer.lexers), table,
             parse_table.start_states["start"], parse_table.end_states["start"], ignored,
-            ignored - {"COMMENT"}))
+            ignored - {"COMMENT"}, _kept(frontend.parser_conf.rules)))
     return _RECOGNIZER[0]
+
+
+def _node(rule) -> str | None:
+    """The tree node a rule makes as lark's tree builder makes it (None: a `_rule`, whose
+    children go to its parent's); `!rule`, `?rule` and `[x]` would change the tree."""
+    options = rule.options
+    # `start` may be empty, but a text ends in a line end, an `_NL`: `read` never reduces it
+    assert rule.expansion or rule.origin.name == "start", "`read` reads no other empty rule"
+    assert not (options.keep_all_tokens or options.expand1 or options.empty_indices), \
+        "grammar.lark: `read` builds trees as lark does for plain rules only"
+    return None if rule.origin.name.startswith("_") else rule.alias or rule.origin.name
+
+
+def _kept(rules) -> frozenset:
+    """The terminals lark keeps in its trees: named ones not written `_NAME`."""
+    symbols = [s for rule in rules for s in rule.expansion if s.is_term]
+    kept = frozenset(s.name for s in symbols if not s.filter_out)
+    assert not kept & {s.name for s in symbols if s.filter_out}, "a terminal kept in one rule only"
+    return kept
+
+
+class _Lexers(dict):
+    """state -> its lexer (see `_lexer`), compiled when a text first reaches the state: a
+    file of a few lines reaches a third of them, and `check` starts sooner (issue 2)."""
+
+    def __init__(self, lexers: dict):
+        super().__init__()
+        self.lexers = lexers  # lark's, by state
+
+    def __missing__(self, state: int) -> tuple:
+        self[state] = found = _lexer(self.lexers[state])
+        return found
 
 
 @functools.lru_cache(maxsize=None)  # states with the same terminals share lark's lexer
@@ -204,20 +330,25 @@ _ACTIVE: list = []  # the _Recovery of the parse under way
 def _raw_line(token):
     """Read a raw block's commands as the controller reads a stored line (mercmac.mdtext);
     its syntax errors are the parser's (one per line, and the file is not checked further)."""
-    text = str(token)
+    token.value = raw = _read_raw(str(token))
+    if raw.problems and _ACTIVE and _ACTIVE[-1]:
+        _ACTIVE[-1].raw_error(token, raw.problems[0])
+    return token
+
+
+def _read_raw(text: str) -> RawLine:
+    """A RAW_LINE token's commands as mercmac.mdtext reads them."""
     header = _HEADER.match(text)
     body = text[header.end():].split("//", 1)[0]  # a comment may end the line
     commands, problems = mdtext.lex(body)
-    token.value = RawLine(mdtext.number(header.group(1)), header.end(), commands, problems)
-    if problems and _ACTIVE and _ACTIVE[-1]:
-        _ACTIVE[-1].raw_error(token, problems[0])
-    return token
+    return RawLine(mdtext.number(header.group(1)), header.end(), commands, problems)
 
 
 class Parsed(NamedTuple):
     """What parsing a file gives: the tree of what parsed, and the lines that did not."""
 
-    tree: object | None  # None: nothing usable (a binary file, or recovery gave up mid-file)
+    tree: object | None  # (ast_builder.parse_module: the AST) None: nothing usable (a
+    # binary file, or recovery gave up mid-file)
     broken: frozenset[int]  # lines with a syntax error: left out of `tree`
     failed: bool = False  # any syntax error (a missing '}' at the end breaks no line)
 
@@ -446,7 +577,7 @@ _IN_MS = (Mnemonic.WA, Mnemonic.WS)  # commands whose argument is milliseconds (
 
 def nearest_keyword(word: str) -> str | None:
     """The keyword a misspelled word most likely means (`whne` -> `when`), or None."""
-    from mercmac.commands import _distance
+    from mercmac.commands import _distance as distance
 
     low = word.lower()
     if low in KEYWORDS:  # `When 1`: keywords are lower case
@@ -454,8 +585,8 @@ def nearest_keyword(word: str) -> str | None:
     if len(low) < 3:
         return None
     limit = 1 if len(low) < 4 else 2
-    best = min(KEYWORDS, key=lambda k: (_distance(low, k), k))
-    if _distance(low, best) <= limit or (len(low) > 3 and sorted(low) == sorted(best)):
+    best = min(KEYWORDS, key=lambda k: (distance(low, k), k))
+    if distance(low, best) <= limit or (len(low) > 3 and sorted(low) == sorted(best)):
         return best
     return None
 

@@ -113,11 +113,10 @@ class Rechecker:
 
 def _parse(chunk: str) -> tuple | None:
     """The items of one chunk, spans counted from its first line; None on a syntax error."""
-    from mercmac.compiler.ast_builder import build
-    from mercmac.compiler.parse import parse
+    from mercmac.compiler.ast_builder import parse_module
 
     report = Report("")
-    tree = parse(chunk, report)
-    if tree is None or report.items:
+    parsed = parse_module(chunk, report)
+    if parsed.failed or report.items:
         return None
-    return build(tree).items
+    return parsed.tree.items
