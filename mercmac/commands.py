@@ -6,8 +6,12 @@ lists mnemonics.  Page numbers are those of the manual's §6.2 table.
 """
 from __future__ import annotations
 
+import functools
+import re
 from enum import Enum
-from typing import NamedTuple
+from typing import Iterable, Mapping, NamedTuple
+
+from mercmac.suggest import suggest
 
 C663 = "C-663"
 C863 = "C-863"
@@ -86,13 +90,16 @@ class Command(NamedTuple):
 
     def expects(self) -> str:
         """What the argument should be, as a phrase: 'EM takes a macro number 1-31'."""
+        return f"{self.mnemonic} takes {self.argument()}"
+
+    def argument(self) -> str:
+        """The argument as a noun phrase: 'a macro number 1-31', 'no argument'."""
         if self.arg is Arg.NONE:
-            return f"{self.mnemonic} takes no argument"
+            return "no argument"
         what = self.arg_name or "a number"
-        if self.lo is not None and self.hi is not None and self.hi - self.lo <= 65_535:
+        if self.lo is not None and self.hi is not None and 0 < self.hi - self.lo <= 65_535:
             what = f"{what} {self.lo}-{self.hi}"
-        optional = " (optional)" if self.arg is Arg.OPTIONAL else ""
-        return f"{self.mnemonic} takes {what}{optional}"
+        return what + (" (optional)" if self.arg is Arg.OPTIONAL else "")
 
     def available_on(self, model: str | None) -> bool:
         return model is None or model in self.models
@@ -142,21 +149,28 @@ _TABLE = (
        arg=_REQ, arg_name="a time in ms", lo=0, hi=MAX_UINT16),
     _c("WS", "Wait until the motor is on target, then n ms (default 1000)", _W, 85,
        arg=_OPT, arg_name="a time in ms", lo=0, hi=MAX_UINT16, default=1000, note_default=True),
-    _c("WN", "Wait until input n is ON", _W, 85, arg=_REQ, arg_name="an input", lo=1, hi=4),
-    _c("WF", "Wait until input n is OFF", _W, 85, arg=_REQ, arg_name="an input", lo=1, hi=4),
+    _c("WN", "Wait until input n is ON (button n of the C-170.PB box pressed)", _W, 85,
+       arg=_REQ, arg_name="an input", lo=1, hi=4),
+    _c("WF", "Wait until input n is OFF (button n released)", _W, 85,
+       arg=_REQ, arg_name="an input", lo=1, hi=4),
     # -- conditions (§5.5, §6.4 XN/XF): inputs 1-4, 5 joystick, 6 joystick button --
-    _c("XN", "Execute the rest of the line only if input n is ON", _X, 87,
+    _c("XN", "Execute the rest of the line only if input n is ON (1-4 the box's buttons, "
+       "5 joystick, 6 joystick button)", _X, 87,
        arg=_REQ, arg_name="an input", lo=1, hi=6),
-    _c("XF", "Execute the rest of the line only if input n is OFF", _X, 87,
+    _c("XF", "Execute the rest of the line only if input n is OFF (1-4 the box's buttons, "
+       "5 joystick, 6 joystick button)", _X, 87,
        arg=_REQ, arg_name="an input", lo=1, hi=6),
     # -- macro calls and repeats (§3.8, §6.4 EM/RP) --
     _c("EM", "Execute macro n", _E, 52, arg=_REQ, arg_name="a macro number", lo=1, hi=31),
     _c("RP", "Repeat the line from its beginning n more times (default 65535)", _R, 70,
        arg=_OPT, arg_name="a repeat count", lo=0, hi=32_568, default=65_535, note_default=True),
     # -- outputs (§4.5) --
-    _c("CN", "Output n ON", _O, 48, arg=_REQ, arg_name="an output", lo=1, hi=4),
-    _c("CF", "Output n OFF", _O, 48, arg=_REQ, arg_name="an output", lo=1, hi=4),
-    _c("CP", "Set outputs 1-4 to the bit pattern n (bit 0 = output 1)", _O, 49,
+    # The C-170.PB box shows the outputs on its LEDs (§3.8.6).
+    _c("CN", "Output n ON (lights LED n of the C-170.PB pushbutton box)", _O, 48,
+       arg=_REQ, arg_name="an output", lo=1, hi=4),
+    _c("CF", "Output n OFF (switches LED n of the C-170.PB pushbutton box off)", _O, 48,
+       arg=_REQ, arg_name="an output", lo=1, hi=4),
+    _c("CP", "Set outputs 1-4 (the box's LEDs) to the bit pattern n (bit 0 = output 1)", _O, 49,
        arg=_REQ, arg_name="an output pattern", lo=0, hi=15),
     _c("ZM", "Trigger mode on output 4 (0 off, 1 single, 2 multiple, 3 grid)", _O, 89,
        arg=_REQ, arg_name="a trigger mode", lo=0, hi=3),
@@ -349,24 +363,47 @@ def lookup(mnemonic: str) -> Command | None:
     return COMMANDS.get(mnemonic.upper())
 
 
+def search(words: Iterable[str], model: str | None = None,
+           guessed: Mapping[str, Iterable[str]] | None = None) -> list[Command]:
+    """The commands (of `model`) that every word describes, best first: its mnemonic, then
+    a word of its summary, argument or kind (`led`, `wait`, `velocity`), then a natural
+    guess for it (`guessed`: word -> mnemonics; `sleep` -> WA), then the start of such a
+    word (`veloc`); among equals, the one that says the words earliest ("Set velocity"
+    before "Report programmed velocity"), then the table's order (the manual's kinds)."""
+    words = [w.lower() for text in words for w in text.split()]
+    found = []
+    for index, c in enumerate(_TABLE):
+        scores = [_score(c, w, guessed or {}) for w in words]
+        if c.available_on(model) and None not in scores:
+            found.append((sum(rank for rank, _ in scores), sum(at for _, at in scores), index))
+    return [_TABLE[index] for *_, index in sorted(found)]
+
+
+def _score(c: Command, word: str, guessed: Mapping[str, Iterable[str]]) -> tuple[int, int] | None:
+    """How well `word` names `c`, and where its description says it (lower is better);
+    None when it does not."""
+    if word == c.mnemonic.lower():
+        return 0, 0
+    described = _described(c)
+    at = _first(described, lambda w: w in (word, word + "s"))  # `led` finds "LEDs" too
+    if at is not None:
+        return 1, at
+    if c.mnemonic in guessed.get(word, ()):
+        return 2, 0
+    at = _first(described, lambda w: w.startswith(word)) if len(word) >= 3 else None
+    return None if at is None else (3, at)
+
+
+def _first(words: tuple[str, ...], test) -> int | None:
+    return next((i for i, w in enumerate(words) if test(w)), None)
+
+
+@functools.cache
+def _described(c: Command) -> tuple[str, ...]:
+    """The words of a command's summary, argument and kind, lower case, in order."""
+    return tuple(re.findall(r"[a-z0-9]+", f"{c.summary} {c.arg_name} {c.kind.value}".lower()))
+
+
 def nearest(word: str) -> str | None:
-    """The known mnemonic closest to an unknown one, for 'did you mean'."""
-    word = word.upper()
-    best, best_cost = None, 3
-    for name in COMMANDS:
-        if abs(len(word) - len(name)) >= best_cost:  # the distance is at least that
-            continue
-        cost = _distance(word, name)
-        if cost < best_cost or (cost == best_cost and best and name < best):
-            best, best_cost = name, cost
-    return best
-
-
-def _distance(a: str, b: str) -> int:
-    """Levenshtein distance; the words are a few letters long."""
-    row = list(range(len(b) + 1))
-    for i, ca in enumerate(a, 1):
-        prev, row[0] = row[0], i
-        for j, cb in enumerate(b, 1):
-            prev, row[j] = row[j], min(row[j] + 1, row[j - 1] + 1, prev + (ca != cb))
-    return row[-1]
+    """The known mnemonic closest to an unknown one (at most 2 edits), for 'did you mean'."""
+    return suggest(word, COMMANDS, limit=2)

@@ -1,5 +1,5 @@
-"""Project settings for `check`: `[tool.mercmac]` in pyproject.toml, or a mercmac.toml,
-found upward from the file being checked (SPEC §5).
+"""Project settings for `check` and the language server: `[tool.mercmac]` in pyproject.toml,
+or a mercmac.toml, found upward from the file being checked (SPEC §5).
 
     [tool.mercmac]                 # in mercmac.toml: the same keys, without the table line
     target = "C-863"               # a default for --target
@@ -50,6 +50,12 @@ def settings_for(path: str) -> Settings:
     working folder's)."""
     folder = os.path.abspath(os.path.dirname(path) if path != "-" else ".")
     return _settings_in(folder)
+
+
+def forget() -> None:
+    """Read the settings files again from now on: the language server runs for hours
+    while they are edited."""
+    _FOUND.clear()
 
 
 def _settings_in(folder: str) -> Settings:

@@ -70,6 +70,7 @@ caret.""", {
         "argument": "{expects}, found {found}",
         "placeholder": "{expects}, found the placeholder '{placeholder}'",
         "keyword": "unknown word '{word}'; did you mean '{keyword}'?",
+        "guess": "unknown word '{word}': {hint}",  # compiler/guesses.py
         "or": "there is no 'or': write one when block per condition, e.g. "
               "`when 1 {{ ... }}` and `when 2 {{ ... }}`",
         "milliseconds": "{command} takes plain milliseconds, without a unit: write "
@@ -89,8 +90,10 @@ caret.""", {
 The controller only knows the base commands of MS176E §6.2. An unknown
 mnemonic in a macro is stored as is and fails silently when the macro runs
 (error 06 "Wrong Command" in the TS report, §6.4 TS). mercmac suggests the
-nearest known mnemonic. Run `mercmac explain` on a rule, or see §6.2 for the
-full list.""", {"": "unknown command '{word}'{hint}"}),
+nearest known mnemonic, or, for a word people write for a command (`LED 1`,
+`wait 100`, `move 5000`), the command the manual has for it. `mercmac commands`
+lists them all (`mercmac commands led` searches), `mercmac explain CN` tells one,
+and §6.2 of the manual has the full list.""", {"": "unknown command '{word}'{hint}"}),
     Rule("MM003", "bad-argument", _E, "argument missing where required, or not a number", """\
 Commands such as MA, MR, EM, CN, WA or XN need a number right after the
 mnemonic (MS176E §6.1.2: "MR alone would be useless"). Arguments are decimal

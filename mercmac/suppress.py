@@ -1,7 +1,8 @@
 """Which diagnostics a user has turned off: by rule (`--select`/`--ignore`, settings) or by
 a comment on the line (`// mercmac: ignore[nested-call]`).
 
-Only `check` reads these: `build`, `sim` and `flash` still refuse a file with errors.
+Only `check` and the language server (mercmac.compiler.checking) read these: `build`, `sim`
+and `flash` still refuse a file with errors.
 A syntax error is never turned off, as in ruff: the rest of its file was not checked.
 A comment that cannot be read turns nothing off and is reported (`invalid-suppression`,
 as ruff's RUF102 reports a `# noqa` with a code it does not know).

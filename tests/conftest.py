@@ -1,6 +1,7 @@
 """Shared test helpers: compile text, run the CLI in-process, write files, find the examples."""
 from __future__ import annotations
 
+import signal
 from pathlib import Path
 
 import pytest
@@ -8,6 +9,13 @@ from click.testing import CliRunner
 
 from mercmac.compiler import compile_source
 from mercmac.source import Source
+
+# A suite started as a background job (`pytest &`) or by some CI runners inherits SIGINT as
+# ignored, and so would every process it starts: the Ctrl-C tests could not interrupt the
+# mercmac they run. This process takes Python's own handler instead; exec resets a handled
+# signal to the default in each child (an ignored one would stay ignored).
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples" / "macros"

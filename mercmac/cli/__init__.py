@@ -29,8 +29,35 @@ class _Commands(click.Group):
         "history": ("mercmac.cli.inspect", "history"),
     }
 
+    # Words people try for a command, and the command they mean (`mercmac simulate`).
+    SYNONYMS = {"simulate": "sim", "simulation": "sim", "upload": "flash", "write": "flash",
+                "program": "flash", "download": "pull", "read": "pull", "lint": "check",
+                "format": "fmt", "compile": "build", "mnemonics": "commands"}
+
     def list_commands(self, ctx: click.Context) -> list[str]:
         return sorted([*super().list_commands(ctx), *self.LAZY])
+
+    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+        if not args and not ctx.resilient_parsing:  # bare `mercmac`: the help, no error
+            click.echo(ctx.get_help())
+            ctx.exit(EXIT_OK)
+        return super().parse_args(ctx, args)
+
+    def resolve_command(self, ctx: click.Context, args: list[str]):
+        name = args[0]
+        if not name.startswith("-") and not ctx.resilient_parsing \
+                and self.get_command(ctx, name) is None:
+            raise click.UsageError(f"No such command {name!r}.{self._meant(ctx, name)}", ctx=ctx)
+        return super().resolve_command(ctx, args)
+
+    def _meant(self, ctx: click.Context, name: str) -> str:
+        """' Did you mean 'sim'?' for a synonym or a misspelling of a command; else ''."""
+        from mercmac.suggest import suggest
+
+        names = self.list_commands(ctx)
+        meant = self.SYNONYMS.get(name.lower()) or (
+            suggest(name, names, max(1, len(name) // 3)) if len(name) <= 40 else None)
+        return f" Did you mean {meant!r}?" if meant else ""
 
     def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
         if name in self.LAZY:
@@ -82,12 +109,11 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
     --warnings-as-errors), 2 when a file cannot be read or an option or setting is wrong.
     """
     def work() -> int:
+        from mercmac.compiler import checking
         from mercmac.diagnostics import Severity
         from mercmac.source import read_source
-        from mercmac import suppress
 
-        chosen = suppress.selection(select, "--select") if select else None
-        dropped = suppress.rule_set(ignore, "--ignore") if ignore else None
+        chosen = checking.options(target, select or None, ignore or None)
         paths, unreadable = _expand(files)
         results, found = [], []
         for f in paths:
@@ -100,9 +126,9 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
                 say(f"cannot read {printable(f)}: {reason(e)}")
                 unreadable += 1
                 continue
-            rules, model = _rules_for(f, chosen, dropped, target)
-            results.append(_check_one(source, model))
-            found += suppress.kept(results[-1].report.items, rules, source)
+            findings = checking.check(source, _choice_for(f, chosen))
+            results.append(findings.compilation)
+            found += findings.diagnostics
         if not results:
             return EXIT_USAGE
         _show(found, results, fmt, statistics, limit)
@@ -128,22 +154,16 @@ def _expand(arguments: tuple[str, ...]) -> tuple[list[str], int]:
     return named.files, len(named.skipped) + len(named.empty)
 
 
-def _rules_for(path: str, select, ignore, target: str | None):
-    """The rules to report on a file and its model: options, else its settings."""
-    from mercmac import config, suppress
+def _choice_for(path: str, chosen):
+    """The rules and model for a file: its settings under the options (mercmac.compiler.checking)."""
+    from mercmac.compiler import checking
     from mercmac.errors import UsageError
     from mercmac.render.report import printable
 
     try:
-        settings = config.settings_for(path)
+        return checking.choice_for(path, chosen)
     except UsageError as e:  # it names a settings file, whose path may hold any character
         raise UsageError(printable(e.message), hint=e.hint) from None
-    where = f"in {printable(settings.path)}" if settings.path else ""
-    if select is None and settings.select is not None:
-        select = suppress.selection(settings.select, f"select {where}")
-    if ignore is None:
-        ignore = suppress.rule_set(settings.ignore or (), f"ignore {where}")
-    return suppress.chosen(select, ignore), target or settings.target
 
 
 def _show(found, results, fmt: str, statistics: bool, limit: int | None) -> None:
@@ -166,28 +186,6 @@ def _show(found, results, fmt: str, statistics: bool, limit: int | None) -> None
     else:
         render.write_text(found, {r.source.name: r.source for r in results}, len(results),
                           limit=cap)
-
-
-def _check_one(source, target: str | None):
-    """Compile one file; a compiler bug becomes an error on that file, and the others go on."""
-    from mercmac.compiler import Compilation, compile_source
-    from mercmac.diagnostics import Report
-    from mercmac.source import Span
-
-    from mercmac.compiler.parse import paused_gc
-
-    try:
-        with paused_gc():
-            return compile_source(source, target=target)
-    except Exception as e:  # last resort (issue 7): never a traceback, never lose the other files
-        report = Report(source.name)
-        try:
-            detail = f"{type(e).__name__}: {e}"
-        except Exception:  # an exception whose text cannot be made
-            detail = type(e).__name__
-        detail = detail if len(detail) <= 200 else detail[:200] + "..."
-        report.add("syntax", Span(1, 1, 1, 2), "internal", detail=detail)
-        return Compilation(source, report, None)
 
 
 @main.command()
@@ -224,7 +222,9 @@ def build(file: str, output: str | None, target: str | None) -> None:
 @main.command()
 @click.argument("key", required=False)
 def explain(key: str | None) -> None:
-    """Explain a rule by code (MM011) or name (nested-call); list them all without one."""
+    """Explain a rule by code (MM011) or name (nested-call), a native command by its
+    mnemonic (MR, cn) or a keyword of the language (when); list the rules without one
+    (`mercmac commands` lists the commands)."""
     def work() -> int:
         from mercmac.render.explain import write_explanation, write_rule_list
 
@@ -232,6 +232,38 @@ def explain(key: str | None) -> None:
             write_rule_list()
         else:
             write_explanation(key)
+        return EXIT_OK
+
+    run_guarded(work)
+
+
+@main.command("commands")
+@click.argument("words", nargs=-1)
+@click.option("--model", type=MODEL_CHOICE, help="Only the commands this model knows.")
+def commands_command(words: tuple[str, ...], model: str | None) -> None:
+    """List the controller's native commands (MS176E §6), or those that WORDS describe:
+    `mercmac commands led`, `mercmac commands wait`, `mercmac commands velocity`.
+
+    A word matches a mnemonic, a word of a command's description (or its start), or a
+    word people write for a command (`sleep`: WA); the best matches come first.
+    `mercmac explain MR` tells one command. Exit 0 when commands are listed, 1 when no
+    command matches (as grep does).
+    """
+    def work() -> int:
+        from mercmac.commands import search
+        from mercmac.compiler import guesses
+        from mercmac.render.commands import write_list
+        from mercmac.render.report import printable
+
+        found = search(words, model, guesses.POINTS_TO)
+        # a word no description has (`sleep`): say what people mean by it
+        said = [f"{w}: {guesses.hint(w)}" for w in words if guesses.hint(w) and not search([w])]
+        if not found:
+            say(f"no command{' of the ' + model if model else ''} mentions "
+                f"'{printable(' '.join(words))}'", "; ".join(said) or
+                "`mercmac commands` lists them all")
+            return EXIT_FAILED
+        write_list(found, said)
         return EXIT_OK
 
     run_guarded(work)

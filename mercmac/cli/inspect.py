@@ -2,12 +2,13 @@
 
 The macros come from a .mcm file (raw `[MCnn]` blocks such as a pull or a backup, or
 a program) or from the controller on --port. A controller that holds exactly a
-program mercmac flashed gets that source back (mercmac.upload.history).
+program mercmac flashed gets that source back (mercmac.upload.history); a file is
+read for what it holds: the history names what controllers hold, not files.
 """
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import click
 
@@ -43,6 +44,7 @@ class Macros:
     origin: str  # the file, or 'PORT, address N'
     port: str | None = None
     address: int | None = None
+    names: dict[int, str] = field(default_factory=dict)  # the source's, by slot (Program.names)
 
 
 def _read(file: str | None, port: str | None, address: int, baud: int, timeout: float) -> Macros:
@@ -70,19 +72,31 @@ def _read_file(file: str) -> Macros:
         raise _Refused()
     program = compilation.program
     macros = {m.slot: m.line for m in program.macros.values()}
-    return Macros(macros, program.target, compilation.source.name)
+    return Macros(macros, program.target, compilation.source.name, names=program.names())
 
 
-def _recorded(read: Macros):
-    """The history record whose source gives back these macros, said on standard error;
-    else None (a record whose source no longer builds to them is said too)."""
+def _recorded(read: Macros, instead: str):
+    """The history record whose source gives back what the controller on --port holds,
+    said on standard error; else None (a record whose source no longer builds to it is
+    said too). None for a file: it is read for what it holds, whatever was flashed."""
     from mercmac.render.history import label
     from mercmac.render.report import printable
 
-    found = recalled(read.macros, read.port, read.address, "decompiled instead")
+    if read.port is None:
+        return None
+    found = recalled(read.macros, read.port, read.address, instead)
     if found:
         click.echo(f"mercmac: {printable(read.origin)} holds {label(found)}", err=True)
     return found
+
+
+def _named(read: Macros) -> Macros:
+    """With the names of the recorded source that builds to what the controller holds."""
+    from mercmac.upload import history
+
+    found = _recorded(read, "described with made-up names instead")
+    program = history.built(found).program if found else None
+    return replace(read, names=program.names()) if program else read
 
 
 def _library():
@@ -140,8 +154,9 @@ def decompile(file, port, address, baud, timeout, output, force) -> None:
     """Turn raw macros back into high-level source that builds to exactly the same macros.
 
     FILE is a .mcm file of `[MCnn]` blocks (a pull, a backup); --port reads the
-    controller instead. A controller or file that holds exactly a program
-    `mercmac flash` wrote gives back that source, with its names and comments.
+    controller instead. A controller that holds exactly a program `mercmac flash`
+    wrote gives back that source, with its names and comments; a FILE is always
+    decompiled from what it holds.
     Exit 1 when FILE has errors or nothing answers, 2 when FILE or the port cannot
     be opened.
     """
@@ -149,7 +164,7 @@ def decompile(file, port, address, baud, timeout, output, force) -> None:
         if not force:
             _not_the_input(file, output)  # refused before a port is read
         read = _read(file, port, address, baud, timeout)
-        found = _recorded(read)
+        found = _recorded(read, "decompiled instead")
         if found:
             text = found.source
         else:
@@ -170,15 +185,18 @@ def decompile(file, port, address, baud, timeout, output, force) -> None:
 def describe(file, port, address, baud, timeout, fmt, graph) -> None:
     """Say what a program does: its macros, what calls what, inputs, outputs and moves.
 
-    FILE is a .mcm file; --port reads the controller instead.
+    FILE is a .mcm file; --port reads the controller instead. Macros have the names
+    the source gives them (on --port: the source `mercmac flash` recorded, when the
+    controller holds exactly its build), else names made from what they do.
     """
     def work() -> int:
         graph_kind = _graph_kind(graph) if graph is not None else None  # before the port is read
-        read = _read(file, port, address, baud, timeout)
+        read = _named(_read(file, port, address, baud, timeout))
         library = _library()
-        text = library.describe(read.macros, model=read.model, fmt=fmt)
+        text = library.describe(read.macros, model=read.model, fmt=fmt, names=read.names)
         if graph is not None:
-            _write_graph(library.call_graph_dot(read.macros, model=read.model), graph, graph_kind)
+            dot = library.call_graph_dot(read.macros, model=read.model, names=read.names)
+            _write_graph(dot, graph, graph_kind)
         click.echo(text, nl=not text.endswith("\n"))
         if graph is not None:
             click.echo(f"mercmac: call graph written to {graph}", err=True)

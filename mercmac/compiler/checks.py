@@ -5,6 +5,8 @@ The pass also resolves what lowering needs: each valid native command as an
 """
 from __future__ import annotations
 
+import functools
+
 from mercmac import mdtext
 from mercmac.commands import MODELS, Arg, lookup
 from mercmac.compiler import ast
@@ -12,6 +14,7 @@ from mercmac.compiler.parse import BROKEN, nearest_keyword
 from mercmac.compiler.program import MAX_RP, MAX_WA, MAX_WAITS, SLOTS, Op, rp_counts
 from mercmac.diagnostics import Report
 from mercmac.source import Span
+from mercmac.suggest import suggest
 
 MAX_REPEAT = MAX_RP + 1  # `repeat N` lowers to RP N-1; MS176E §6.4 RP: n <= 32568
 MAX_PERIOD_MS = MAX_WA * MAX_WAITS  # `every T` lowers to WA T, several WAs past 65535 ms
@@ -152,34 +155,13 @@ def _macro_name(name: str, span: Span, env: Env, report: Report) -> None:
 
 
 def _suggest(name: str, known) -> str:
-    """'did you mean' the defined name nearest to `name`: the same but for case, else the
-    fewest edits (at most a third of the name; a swap of two letters counts 1),
-    else the same first three letters."""
-    low = name.lower()
-    close = sorted(k for k in known if k.lower() == low)
-    if not close:
-        limit = len(name) // 3
-        costs = sorted((_edits(low, k.lower()), k) for k in known)
-        close = [k for cost, k in costs[:1] if cost <= limit]
-    if not close:
-        close = sorted(k for k in known if k.lower().startswith(low[:3]))
-    return f"; did you mean '{close[0]}'?" if close else ""
-
-
-def _edits(a: str, b: str) -> int:
-    """Edit distance with adjacent swaps (optimal string alignment): `scna` -> `scan` is 1."""
-    if abs(len(a) - len(b)) > 3:
-        return abs(len(a) - len(b))
-    prev2: list[int] = []
-    prev = list(range(len(b) + 1))
-    for i in range(1, len(a) + 1):
-        row = [i] + [0] * len(b)
-        for j in range(1, len(b) + 1):
-            row[j] = min(prev[j] + 1, row[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1]))
-            if i > 1 and j > 1 and a[i - 1] == b[j - 2] and a[i - 2] == b[j - 1]:
-                row[j] = min(row[j], prev2[j - 2] + 1)
-        prev2, prev = prev, row
-    return prev[-1]
+    """'did you mean' the defined name nearest to `name` (mercmac.suggest: at most a third
+    of the name in edits), else the first with the same first three letters."""
+    close = suggest(name, known, limit=len(name) // 3)
+    if close is None:
+        low = name.lower()
+        close = min((k for k in known if k.lower().startswith(low[:3])), default=None)
+    return f"; did you mean '{close}'?" if close else ""
 
 
 def _bounded(value: ast.Value, env: Env, report: Report, allowed: range, what: str,
@@ -228,13 +210,37 @@ def _command(cmd: ast.Command, env: Env, report: Report, *, raw: bool) -> None:
     checked = mdtext.validate(cmd.word, value, model=env.target)
     for f in checked.findings:
         values = dict(f.values)
-        if f.rule == "unknown-command" and not raw and cmd.value is not None:  # `cal scan`: a keyword, not a command
-            keyword = nearest_keyword(cmd.word)
-            if keyword is not None and "hint" in values:
-                values["hint"] = f"; did you mean '{keyword}'?"
+        if f.rule == "unknown-command":
+            values["hint"] = _unknown_hint(cmd, values["hint"], raw)
         report.add(f.rule, _where(cmd, f), f.variant, **values)
     if checked.op is not None:
         env.ops[cmd] = checked.op._replace(span=cmd.span)
+
+
+def _unknown_hint(cmd: ast.Command, spelling: str, raw: bool) -> str:
+    """What an unknown command's message ends with: the hint of a natural guess (`LED 1`:
+    write `CN 1`; compiler/guesses.py), else a keyword misspelled (`cal scan`: a keyword,
+    not a command), else the nearest mnemonic by spelling (`spelling`, from mdtext)."""
+    guessed = _guessed(cmd.word, _argument(cmd.value), raw)
+    if guessed is not None:
+        return f"; {guessed}"
+    keyword = nearest_keyword(cmd.word) if not raw and cmd.value is not None else None
+    return f"; did you mean '{keyword}'?" if keyword is not None else spelling
+
+
+# A 1 MB line of unknown commands asks for the same few words 250,000 times (check_large).
+@functools.lru_cache(maxsize=1024)
+def _guessed(word: str, argument: str | None, raw: bool) -> str | None:
+    from mercmac.compiler import guesses  # only once a command is unknown: `check` starts quick
+
+    return guesses.hint(word, argument, raw=raw)
+
+
+def _argument(value) -> str | None:
+    """The argument as the user wrote it, near enough for a hint: `1`, `FAST`."""
+    if isinstance(value, ast.Number):
+        return str(value.value)
+    return value.name if isinstance(value, ast.Name) else None
 
 
 def _where(cmd: ast.Command, f: mdtext.Finding) -> Span:

@@ -577,7 +577,7 @@ _IN_MS = (Mnemonic.WA, Mnemonic.WS)  # commands whose argument is milliseconds (
 
 def nearest_keyword(word: str) -> str | None:
     """The keyword a misspelled word most likely means (`whne` -> `when`), or None."""
-    from mercmac.commands import _distance as distance
+    from mercmac.suggest import distance
 
     low = word.lower()
     if low in KEYWORDS:  # `When 1`: keywords are lower case
@@ -608,6 +608,14 @@ def _hint(e, text: str, line: int):
     row = text.count("\n", 0, start) + 1
     if row != line:
         return None
+    starts = [m for m in _STATEMENT_WORD.finditer(code) if m.start(1) <= here]
+    if starts and lookup(starts[-1].group(1)) is None:  # `if 1 {`, `wait 100ms`, `loop {`
+        from mercmac.compiler import guesses
+
+        m = starts[-1]
+        guessed = guesses.syntax_hint(m.group(1), code[m.end(1):])
+        if guessed is not None:
+            return Span(row, m.start(1) + 1, row, m.end(1) + 1), *guessed
     for m in _STATEMENT_WORD.finditer(code):  # `whne 1 {`, `macor scan {`
         word = m.group(1)
         if m.start(1) > here or lookup(word) is not None:

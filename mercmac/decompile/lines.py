@@ -5,10 +5,14 @@ import re
 from typing import NamedTuple
 
 from mercmac import mdtext
-from mercmac.commands import C663, C863, MODELS, Mnemonic, lookup
+from mercmac.commands import C663, C863, MODELS, Kind, Mnemonic, lookup
 from mercmac.source import split_lines
 
 CONDITIONS = (Mnemonic.XN, Mnemonic.XF)
+CYCLE_MS = 1  # SPEC §3 Time: each executed command takes one controller cycle, 1 ms by default
+# Commands that take one cycle and go on; a wait for the motor or an input, a condition that
+# may leave, a call and macro management take what the machine makes of them.
+_ONE_CYCLE = (Kind.MOTION, Kind.OUTPUT, Kind.SETTING, Kind.REPORT, Kind.REPEAT)
 _HEADER = re.compile(r"\s*(?:\[\s*MC\s*\+?\s*(\d+)\s*\]|MC\s*(\d+)\b|MD\s*(\d+)\s*(?:,|$))(.*)",
                      re.IGNORECASE)
 
@@ -85,25 +89,80 @@ def every_period(ops) -> int | None:
     return None
 
 
+class Runs(NamedTuple):
+    """How often a line with RPs runs, and for how long (SPEC §3 Repeat counters, Time)."""
+
+    times: int  # how often the line's start runs
+    ms: int | None  # the whole line, first command to last, when every command's time is known
+    exact: bool  # False: a condition, or a call that does not come back, may end it sooner
+
+
+def runs(line: Line, lines: dict[int, Line]) -> Runs | None:
+    """None for a line without RP. `RP n` runs what stands before it n+1 times (a bare RP:
+    65,536); a later RP runs the whole line again, where the earlier RP's forgotten counter
+    starts over, so the counts multiply: `WA20,RP,RP` runs 65,536 x 65,536 times. Each
+    command counts as often as the RPs after it make the line pass it."""
+    ops = line.ops or ()
+    if not any(op.mnemonic == Mnemonic.RP for op in ops):
+        return None
+    times, ms = 1, 0
+    for op in reversed(ops):
+        if op.mnemonic == Mnemonic.RP:
+            times *= _repeat_count(op)
+        took = _command_ms(op)
+        ms = None if ms is None or took is None else ms + took * times
+    ends = any(op.mnemonic in CONDITIONS or (op.mnemonic == Mnemonic.EM
+                                              and not _comes_back(op.arg, line.slot, lines))
+               for op in ops)
+    return Runs(times, ms, not ends)
+
+
+def _repeat_count(op) -> int:
+    """How often an `RP n` lets the line pass it: n + 1 (SPEC §3; a bare RP is RP65535)."""
+    return (lookup(Mnemonic.RP).default if op.arg is None else op.arg) + 1
+
+
+def _command_ms(op) -> int | None:
+    """How long one command takes, or None when the machine decides (a wait, a call)."""
+    if op.mnemonic == Mnemonic.WA:  # §6.4 WA: n ms from its start, at least its cycle
+        return max(op.arg, CYCLE_MS)
+    if op.mnemonic == Mnemonic.JT:
+        from mercmac.vm.machine import JT_US  # §6.4 JT: "takes about 2 seconds"
+
+        return JT_US // 1000
+    return CYCLE_MS if lookup(op.mnemonic).kind in _ONE_CYCLE else None
+
+
+def _comes_back(target: int, caller: int, lines: dict[int, Line]) -> bool:
+    """Whether `EM target` returns to the caller's line: the target calls no macro, which
+    would take the one return point (MS176E §3.8.4), and does not enter the caller anew."""
+    line = lines.get(target)
+    return target != caller and (line is None or not any(
+        lookup(op.mnemonic).kind in (Kind.CALL, Kind.MACRO) for op in line.ops or ()))
+
+
 def button_words(ops) -> str:
     """'1', '2_and_3', 'not_2': the inputs of a condition run, for a name."""
     return "_and_".join(("not_" if op.mnemonic == Mnemonic.XF else "") + str(op.arg) for op in ops)
 
 
-def names(lines: dict[int, Line]) -> dict[int, str]:
-    """A stable, unique name for each slot, made from what its line does."""
+def names(lines: dict[int, Line], given: dict[int, str] | None = None) -> dict[int, str]:
+    """A stable, unique name for each slot: the `given` one (the source's), else one made
+    from what its line does, unlike any given one."""
     calls = callers(lines)
     modes: dict[int, str] = {}
     for line in lines.values():  # a loop entered by a tail EM of a conditioned line: a mode
         run = condition_run(line.ops)
         if run and line.ops and line.ops[-1].mnemonic == Mnemonic.EM:
             modes.setdefault(line.ops[-1].arg, button_words(run))
-    out: dict[int, str] = {}
-    used: set[str] = set()
+    out = {s: name for s, name in (given or {}).items() if s in lines}
+    used = set(out.values())
     # What a loop answers is named after the loop: the loops are named first.
     answers = {s for s, line in lines.items() if condition_run(line.ops)
                and len(calls.get(s, ())) == 1 and every_period(lines[calls[s][0]].ops) is not None}
     for slot, line in sorted(lines.items(), key=lambda item: (item[0] in answers, item[0])):
+        if slot in out:
+            continue
         if slot in answers:
             base = f"{out[calls[slot][0]]}_button_{button_words(condition_run(line.ops))}"
         else:
@@ -141,4 +200,4 @@ def _name(line: Line, mode: str | None, from_autostart: bool) -> str:
     return f"mc{line.slot:02d}"
 
 
-__all__ = ["C663", "C863", "Line", "read_macros", "read_lines", "model_of", "names"]
+__all__ = ["C663", "C863", "Line", "Runs", "read_macros", "read_lines", "model_of", "names", "runs"]

@@ -3,24 +3,33 @@ describes its examples, grouped as a person reads a program."""
 from __future__ import annotations
 
 import json
+import re
 
 from mercmac.commands import C663, Mnemonic, lookup
-from mercmac.render.sim import plural
+from mercmac.render.sim import duration, plural
+from mercmac.timespec import format_duration
 from mercmac.decompile.lines import (Line, condition_run, every_period, model_of, names,
-                                     read_lines)
+                                     read_lines, runs)
 
 _UNITS = {C663: "steps"}  # MS176E §3: the C-663 counts microsteps, the C-863 encoder counts
 
 
 class _Reader:
-    def __init__(self, macros: dict[int, str], model: str | None):
+    def __init__(self, macros: dict[int, str], model: str | None,
+                 given: dict[int, str] | None = None):
         self.lines = read_lines(macros)
         self.model = model_of(self.lines, model)
         self.unit = _UNITS.get(self.model, "counts") if self.model else "counts"
-        self.names = names(self.lines)
+        # The source's names, as `sim` and `flash` show them (Macro.label); a raw slot's
+        # name is its tag, and it gets a name made from what it does instead.
+        self.given = {s: n for s, n in (given or {}).items() if n != f"MC{s:02d}"}
+        self.names = names(self.lines, self.given)
 
     # -- words for one line -------------------------------------------------------------------------
     def label(self, slot: int) -> str:
+        """'jog (MC01)' for a macro the source names, 'MC01 (mode_1)' for a raw one."""
+        if slot in self.given and slot in self.lines:
+            return f"{self.names[slot]} (MC{slot:02d})"
         return f"MC{slot:02d} ({self.names[slot]})" if slot in self.lines else f"MC{slot:02d}"
 
     def words(self, line: Line) -> str:
@@ -28,26 +37,39 @@ class _Reader:
             return "cannot be read as commands: " + (line.text or "empty")
         if not line.ops:
             return "does nothing"
-        return self.phrase(list(line.ops))
+        return self.phrase(list(line.ops), line)
 
-    def phrase(self, ops: list) -> str:
+    def phrase(self, ops: list, line: Line) -> str:
+        """`ops`, a part of `line` that ends with it: its RPs repeat the whole line."""
         run = condition_run(ops)
         if run:
             rest = ops[len(run):]
-            return f"only while {_condition(run)}: " + (self.phrase(rest) if rest else "nothing")
+            return (f"only while {_condition(run)}: "
+                    + (self.phrase(rest, line) if rest else "nothing"))
         period = every_period(ops)
-        if period is not None and not any(o.mnemonic == Mnemonic.RP for o in ops[:-3]):
+        if period is not None and not _repeats(ops[:-3]):
             body = self.steps(ops[:-3])
-            return f"every {period} ms, forever: " + (_series(body) if body else "wait")
-        steps, i = [], 0
+            return (f"every {period} ms, {self.times(line)}: "
+                    + (_series(body) if body else "wait"))
+        steps, mine = [], ops
         for i, op in enumerate(ops):
             run = condition_run(ops[i:])
             if run:
                 steps.append(f"only while {_condition(run)}: "
-                             + self.phrase(ops[i + len(run):]))
-                return _series(steps)
+                             + self.phrase(ops[i + len(run):], line))
+                mine = ops[:i]
+                break
             steps.append(self.command(op, tail=i == len(ops) - 1))
+        if _repeats(mine) and not _repeats(ops[len(mine):]):  # said once, after the last RP
+            return f"{_series(steps)}; the line runs {self.times(line)}"
         return _series(steps)
+
+    def times(self, line: Line) -> str:
+        """'4,294,967,296 times (about 1,094 d)', as the simulator counts them; 'up to'
+        when a condition or a call may end the line sooner."""
+        found = runs(line, self.lines)
+        said = ("" if found.exact else "up to ") + plural(found.times, "time")
+        return said + (f" ({_length(found.ms)})" if found.ms is not None else "")
 
     def steps(self, ops: list) -> list[str]:
         return [self.command(op, tail=False) for op in ops]
@@ -124,7 +146,7 @@ class _Reader:
                 if target in self.lines:
                     out.append({"mode": target, "name": self.names[target], "by": line.slot,
                                 "condition": _condition(run, at_start=True),
-                                "first": self.phrase(list(line.ops[len(run):-1])) or "",
+                                "first": self.phrase(list(line.ops[len(run):-1]), line) or "",
                                 "at_power_on": line.slot in self.startup()})
         return out
 
@@ -140,7 +162,7 @@ class _Reader:
                 run = condition_run(t.ops if t else None)
                 if t is not None and run:
                     answers.append({"slot": target, "condition": _condition(run, at_start=True),
-                                    "does": self.phrase(list(t.ops[len(run):]))})
+                                    "does": self.phrase(list(t.ops[len(run):]), t)})
             out.append({"slot": line.slot, "name": self.names[line.slot], "period_ms": period,
                         "answers": answers})
         return out
@@ -164,8 +186,25 @@ class _Reader:
             "unreached": [s for s in self.lines if s not in reached and 0 in self.lines],
             "macros": [{"slot": s, "name": self.names[s], "line": line.text,
                         "does": self.words(line), "calls": line.ems(),
-                        "reached": s in reached} for s, line in self.lines.items()],
+                        "runs": self.runs(line), "reached": s in reached}
+                       for s, line in self.lines.items()],
         }
+
+    def runs(self, line: Line) -> dict | None:
+        """How often the line runs and for how long (ms), as the simulator counts."""
+        found = runs(line, self.lines)
+        return None if found is None else {"times": found.times, "duration_ms": found.ms,
+                                           "exact": found.exact}
+
+
+def _repeats(ops) -> bool:
+    return any(op.mnemonic == Mnemonic.RP for op in ops)
+
+
+def _length(ms: int) -> str:
+    """'92 ms' when that is exact, else 'about 1,094 d' (three digits, as the timeline)."""
+    rounded, exact = duration(ms * 1000), format_duration(ms)
+    return exact if len(exact) <= len(rounded) else f"about {rounded}"
 
 
 def _condition(run, at_start: bool = False) -> str:
@@ -199,23 +238,43 @@ def _series(steps: list[str]) -> str:
 
 # -- renderings ------------------------------------------------------------------------------------
 
-def describe(macros: dict[int, str], *, model: str | None = None, fmt: str = "text") -> str:
-    reader = _Reader(macros, model)
+def describe(macros: dict[int, str], *, model: str | None = None, fmt: str = "text",
+             names: dict[int, str] | None = None) -> str:
+    """The program in words; `names`: the source's macro names by slot (Program.names())."""
+    reader = _Reader(macros, model, names)
     data = reader.data()
     if fmt == "json":
         return json.dumps(data, indent=2, ensure_ascii=False) + "\n"
     if fmt not in ("text", "markdown"):
         raise ValueError(f"unknown format {fmt!r}: text, markdown or json")
     md = fmt == "markdown"
-    out = [("# " if md else "") + _title(reader, data)]
+    out = [f"# {_inline(_title(reader, data))}" if md else _title(reader, data)]
     for head, items in _sections(reader, data):
         if not items:
             continue
         out += ["", f"## {head}" if md else f"{head}:"]
-        out += [("- " if md else "  ") + item for item in items]
+        out += [_item(depth, text, md) for depth, text in items]
     if md:
         out += ["", "## Call graph", "", "```mermaid", _mermaid(reader), "```"]
     return "\n".join(out) + "\n"
+
+
+def _item(depth: int, text: str, md: bool) -> str:
+    """One item of a section; a nested one under the item before it. In markdown a nested
+    item starts at its parent's text (CommonMark §5.2: four spaces more make a code block)."""
+    if md:
+        return "  " * depth + "- " + _inline(text)
+    return "  " + "    " * depth + text
+
+
+# What CommonMark would read as markup in our text (§2.4 backslash escapes): code spans,
+# emphasis (`_` only at the edge of a word: inside one it is a letter, §6.2), links,
+# HTML and entities. Names and raw lines may hold any of them.
+_MARKUP = re.compile(r"[\\`*\[\]<>&]|(?<!\w)_|_(?!\w)")
+
+
+def _inline(text: str) -> str:
+    return _MARKUP.sub(lambda m: "\\" + m.group(), text)
 
 
 def _title(reader: _Reader, data: dict) -> str:
@@ -223,29 +282,34 @@ def _title(reader: _Reader, data: dict) -> str:
     return f"{plural(len(reader.lines), 'macro')} for {model}; distances in {reader.unit}"
 
 
-def _sections(reader: _Reader, data: dict) -> list[tuple[str, list[str]]]:
+def _sections(reader: _Reader, data: dict) -> list[tuple[str, list[tuple[int, str]]]]:
+    """The sections in order, each item (depth, text): depth 1 is an item of the one above."""
     label = reader.label
     power = [f"{label(0)}: {data['power_on']['does']}"] if data["power_on"] else [
         "nothing: there is no macro 0, so nothing runs by itself"]
-    modes, ways = [], {}
+    ways: dict[int, list[str]] = {}
     for m in data["modes"]:
         when = " at power-on" if m["at_power_on"] else ""
         first = f", which first does: {m['first']}" if m["first"] else ""
-        by = f"MC{m['by']:02d} {reader.names[m['by']]}"
-        ways.setdefault(m["mode"], []).append(f"{m['condition']}{when} (through {by}{first})")
-    for mode, how in ways.items():
-        modes.append(f"{label(mode)}: chosen while " + "; or while ".join(how))
+        ways.setdefault(m["mode"], []).append(
+            f"{m['condition']}{when} (through {label(m['by'])}{first})")
+    modes = [f"{label(mode)}: chosen while " + "; or while ".join(how)
+             for mode, how in ways.items()]
     loops = []
     for loop in data["loops"]:
-        loops.append(f"{label(loop['slot'])}: every {loop['period_ms']} ms")
-        loops += [f"    while {a['condition']}, {label(a['slot'])}: {a['does']}"
+        loops.append((0, f"{label(loop['slot'])}: every {loop['period_ms']} ms"))
+        loops += [(1, f"while {a['condition']}, {label(a['slot'])}: {a['does']}")
                   for a in loop["answers"]]
     leds = [f"{label(x['slot'])}: " + "; ".join(x["lights"]) for x in data["leds"]]
     every = [f"{label(m['slot'])}: {m['does']}" for m in data["macros"]]
     never = [f"{label(s)}" for s in data["unreached"]]
-    return [("At power-on", power), ("Modes chosen by buttons", modes),
-            ("Polling loops and the buttons they answer", loops), ("LEDs", leds),
-            ("Every macro", every), ("Never reached from macro 0", never)]
+    return [("At power-on", _top(power)), ("Modes chosen by buttons", _top(modes)),
+            ("Polling loops and the buttons they answer", loops), ("LEDs", _top(leds)),
+            ("Every macro", _top(every)), ("Never reached from macro 0", _top(never))]
+
+
+def _top(texts: list[str]) -> list[tuple[int, str]]:
+    return [(0, text) for text in texts]
 
 
 def _edges(reader: _Reader):
@@ -268,11 +332,10 @@ def _edges(reader: _Reader):
 
 def _node(reader: _Reader, s: int) -> str:
     """'MC15 mode_1' plus the loop it runs, if any: 'every 20 ms', 'repeat 10 times'."""
-    ops = reader.lines[s].ops or ()
-    period = every_period(ops)
-    rp = [o.arg for o in ops if o.mnemonic == Mnemonic.RP]
-    loop = f"every {period} ms" if period is not None else \
-        f"repeat {rp[0] + 1} times" if len(rp) == 1 and rp[0] is not None else ""
+    period = every_period(reader.lines[s].ops)
+    found = runs(reader.lines[s], reader.lines)
+    loop = f"every {period} ms" if period is not None else "" if found is None else \
+        f"repeat {'' if found.exact else 'up to '}{found.times:,} times"
     return f"MC{s:02d} {reader.names[s]}" + (f" ({loop})" if loop else "")
 
 
@@ -285,10 +348,11 @@ def _mermaid(reader: _Reader) -> str:
     return "\n".join(out)
 
 
-def call_graph_dot(macros: dict[int, str], *, model: str | None = None) -> str:
+def call_graph_dot(macros: dict[int, str], *, model: str | None = None,
+                   names: dict[int, str] | None = None) -> str:
     """The call graph as Graphviz dot: solid edges for calls, dashed for a tail EM (goto),
     labelled with the condition that guards them; loops named on their macro."""
-    reader = _Reader(macros, model)
+    reader = _Reader(macros, model, names)
     out = ["digraph macros {", "    rankdir=LR;", "    node [shape=box];",
            "    edge [fontsize=10];"]
     for s in reader.lines:

@@ -10,7 +10,12 @@ between tokens and the spelling of a few tokens, never the program:
 - 4 spaces of indentation per open brace; the user's line breaks and commas stay,
   runs of blank lines are kept up to MAX_BLANK_LINES, none at the start or the end;
 - a comment stays where it stands: on a line of its own (indented with the code),
-  or after the code of its line, three spaces after it (as in the examples);
+  or after the code of its line. Trailing comments of consecutive lines stand in one
+  column, three spaces after the longest code of the run (as gofmt aligns them, with the
+  examples' gap); a blank line, a line of comment only, a line without a comment, or one
+  whose code is longer than ALIGN_WIDTH ends the run. Unlike gofmt, lines of different
+  depth align too, so that a block's opening line and its statements can be commented
+  side by side (the README's tour);
 - a raw `[MCnn]` block is written as MMCRun saves it (MS176E §3.8.6, Example 4):
   `[MC05] BF,DP200,DI,DD200`, upper case, no blanks, the user's signs kept (`EM+9`).
   A block with a syntax error in its commands (`EMxx`) keeps them as written;
@@ -33,8 +38,12 @@ from mercmac.source import LINE_END, Encoding, to_lf
 INDENT = "    "
 # MMCRun leaves three blank lines after its header comment (MS176E §3.8.6, Example 4).
 MAX_BLANK_LINES = 3
-# The examples' house style: three spaces between code and its comment.
+# The examples' house style: three spaces between the longest code of a run of
+# commented lines and the column of its comments.
 COMMENT_GAP = "   "
+# Longer code is not aligned with its neighbours: padding 10,000 short lines to the column
+# of one 1 MB line would write 10 GB (issue 20's hostile files).
+ALIGN_WIDTH = 100
 
 _HEADER = re.compile(r"\[[ \t]*MC([^\]]*)\]", re.IGNORECASE)
 _BLANKS = re.compile(r"[ \t\f\v]+")
@@ -160,16 +169,38 @@ def _spell(kind: str, value: str) -> str:
 def _render(lines: list[_Line | None]) -> str:
     while lines and lines[-1] is None:
         lines.pop()
-    out = []
-    for line in lines:
-        if line is None:
-            out.append("")
-        elif not line.code:
-            out.append(INDENT * max(line.depth, 0) + line.comment)
-        else:
-            gap = COMMENT_GAP if line.comment else ""
-            out.append(INDENT * max(line.depth, 0) + line.code + gap + line.comment)
+    codes = ["" if line is None else INDENT * max(line.depth, 0) + line.code for line in lines]
+    columns = _comment_columns(lines, codes)
+    out = [code.ljust(column) + (line.comment if line else "")
+           for line, code, column in zip(lines, codes, columns)]
     return "".join(line + "\n" for line in out)
+
+
+def _comment_columns(lines: list[_Line | None], codes: list[str]) -> list[int]:
+    """Where each line's comment starts: for a run of consecutive lines that each end in a
+    comment, COMMENT_GAP after the run's longest code; 0 (right after the code) elsewhere.
+    A line longer than ALIGN_WIDTH is a run of its own."""
+    columns = [0] * len(lines)
+    start = 0
+    for end in range(len(lines) + 1):
+        if end < len(lines) and _trailing(lines[end]) and len(codes[end]) <= ALIGN_WIDTH:
+            continue
+        _align(columns, codes, range(start, end))
+        if end < len(lines) and _trailing(lines[end]):
+            _align(columns, codes, range(end, end + 1))
+        start = end + 1
+    return columns
+
+
+def _align(columns: list[int], codes: list[str], run: range) -> None:
+    if run:
+        column = max(len(codes[i]) for i in run) + len(COMMENT_GAP)
+        columns[run.start:run.stop] = [column] * len(run)
+
+
+def _trailing(line: _Line | None) -> bool:
+    """Whether a line has code and a comment after it."""
+    return line is not None and bool(line.code) and bool(line.comment)
 
 
 # -- raw blocks ---------------------------------------------------------------------------------

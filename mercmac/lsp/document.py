@@ -3,16 +3,21 @@
 pygls cuts a document with `str.splitlines`, which also ends a line at \\f, \\v, \\x1c-\\x1e,
 U+0085, U+2028 and U+2029. Editors end lines at LF, CRLF and CR only (LSP specification,
 "Text Documents"), so an edit sent for one line landed on another and the copy drifted
-from the editor's (issue 20). A Document cuts lines with mercmac.source.LINE_END, and
-turns LSP positions into offsets in one place (`offset_at`), counting characters in the
-units the client and server agreed on (UTF-16 unless said otherwise).
+from the editor's (issue 20). A Document cuts lines with mercmac.source.LINE_END.
+
+Every position the server reads or sends goes through it, counting characters in the
+units the client and server agreed on (`positionEncoding`: UTF-16 unless the client
+offers UTF-8 or UTF-32), while the compiler's spans count characters (code points): an
+emoji is one character and two UTF-16 units, and a position counted in characters put a
+formatting edit's end inside the last line (issue 16). Reading: `offset_at` (an index
+into the text) and `spot` (a 1-based line and column); sending: `position` and `range_of`.
 """
 from __future__ import annotations
 
 from lsprotocol import types as t
 from pygls.workspace import TextDocument, Workspace
 
-from mercmac.source import LINE_END, split_lines
+from mercmac.source import LINE_END, Span, split_lines
 
 
 class Document(TextDocument):
@@ -44,6 +49,34 @@ class Document(TextDocument):
             return len(self.source)
         line = lines[position.line]
         return starts[position.line] + self._index(line, position.character)
+
+    def spot(self, position: t.Position) -> tuple[int, int]:
+        """The 1-based line and column (in characters, as spans count) of an LSP position."""
+        _, lines = self._lines_of_source()
+        if position.line >= len(lines):
+            return len(lines), len(lines[-1]) + 1
+        return position.line + 1, self._index(lines[position.line], position.character) + 1
+
+    def position(self, line: int, column: int) -> t.Position:
+        """The LSP position of a 1-based line and column: a column past the end of its line
+        means the end of the line, a line past the last one the end of the text."""
+        _, lines = self._lines_of_source()
+        if line > len(lines):
+            return self.end()
+        if line < 1:
+            return t.Position(0, 0)
+        text = lines[line - 1]
+        head = text[:min(max(column - 1, 0), len(text))]
+        return t.Position(line - 1, len(head) if head.isascii()
+                          else self.position_codec.client_num_units(head))
+
+    def range_of(self, span: Span) -> t.Range:
+        """The LSP range of a compiler span (its end column exclusive; an end of 0 means
+        the start's line, and one character)."""
+        end_line = span.end_line or span.line
+        end_column = span.end_column or span.column + 1
+        return t.Range(self.position(span.line, span.column),
+                       self.position(end_line, end_column))
 
     def end(self) -> t.Position:
         """The position just past the last character."""

@@ -43,3 +43,10 @@ def write_lines(lines: Iterable[Line], stream: IO[str] | None = None) -> None:
     console = rich_console(stream, colour=True)
     for line in lines:
         console.print(Text.assemble(*line), overflow="ignore", crop=False)
+
+
+def table(header: tuple[str, ...], rows: list[tuple[str, ...]], style_of=lambda row: "") -> list[Line]:
+    """Left-aligned columns; the same Lines in plain text and through rich."""
+    widths = [max(len(str(c)) for c in col) for col in zip(header, *rows)]
+    fmt = lambda row: "  ".join(f"{str(c):<{w}}" for c, w in zip(row, widths)).rstrip()  # noqa: E731
+    return [[(fmt(header), "bold")]] + [[(fmt(row), style_of(row))] for row in rows]

@@ -50,8 +50,9 @@ p.help {{ color: #555; font-size: 90%; }}
 </head>
 <body>
 <h1 style="font-size: 120%">{title}</h1>
-<p class="help">Lanes: position, buttons, LEDs, macro. Wheel: zoom; drag: pan;
-double-click or 0: the whole run.</p>
+<p class="help">Lanes: position, buttons, LEDs, macro. Hatched: time drawn compressed
+(fast-forwarded, or idle after the program ended); a red arrow on an edge: a target beyond
+the position axis. Wheel: zoom; drag: pan; double-click or 0: the whole run.</p>
 <div id="plot">
 {svg}
 </div>

@@ -9,7 +9,7 @@ import os
 import sys
 from typing import IO
 
-from mercmac.render.console import Line, rich_console, use_colour, write_lines
+from mercmac.render.console import Line, rich_console, table, use_colour, write_lines
 from mercmac.render.sim import plural
 
 _FATE_STYLE = {"written": "bold green", "erased": "bold yellow", "re-written last": "green",
@@ -147,7 +147,7 @@ def flash_summary(result, port: str) -> list[Line]:
                   style_of=lambda row: styles.get(row[2], ""))
     if dry:
         lines.append([("dry run: ", "bold yellow"), (f"nothing written; {_would(plan)}", "")])
-        return lines + _restore_note(result)
+        return lines + _kept_note(result)
     lines.append([("ok: ", "bold green"), (_outcome(plan), "")])
     if result.unrecorded:  # the flash stands; only `pull` giving back this source is lost
         lines.append([("warning: ", "bold yellow"),
@@ -158,7 +158,7 @@ def flash_summary(result, port: str) -> list[Line]:
         again = ", ".join(f"MC{s:02d}" for s in result.retried + result.repaired)
         lines.append([("note: ", "bold yellow"), (f"needed a second write: {again} (check the cable)", "")])
     lines.append([("backup: ", "bold"), (str(result.backup), "")])
-    lines += _restore_note(result)
+    lines += _kept_note(result)
     if result.reset:
         lines.append([("reset: ", "bold"), ("RT sent, macro 0 is starting", "")])
     elif 0 in plan.after and not plan.changes_nothing:
@@ -166,16 +166,23 @@ def flash_summary(result, port: str) -> list[Line]:
     return lines
 
 
-def _restore_note(result) -> list[Line]:
-    """A backup flashed back without --erase-unused leaves the macros it lacks: say so."""
-    extra = result.left_over if result.restoring else []
+def _kept_note(result) -> list[Line]:
+    """A flash without --erase-unused leaves the macros the file lacks: say so, and how to
+    remove them (for a backup: how to restore it exactly)."""
+    extra = result.left_over
     if not extra:
         return []
-    held = len(result.plan.after) - len(extra)
     slots = ", ".join(f"MC{s:02d}" for s in extra)
+    kept = _kept(len(extra), result.dry_run)
+    if not result.restoring:
+        return [[("note: ", "bold yellow"),
+                 (f"the controller also holds {slots}, which {kept} (not in the file): "
+                  f"flash with --erase-unused to remove {'it' if len(extra) == 1 else 'them'}",
+                  "")]]
+    held = len(result.plan.after) - len(extra)
     return [[("note: ", "bold yellow"),
              (f"this backup holds {plural(held, 'macro')}; the controller also "
-              f"holds {slots}, which {_kept(len(extra), result.dry_run)}: to "
+              f"holds {slots}, which {kept}: to "
               f"restore the backup exactly, flash it again with --erase-unused", "")]]
 
 
@@ -257,13 +264,6 @@ def ports_lines(ports) -> list[Line]:
              p.description, f"likely Mercury ({p.mercury})" if p.mercury else "") for p in ports]
     return table(("port", "usb id", "description", ""), rows,
                  style_of=lambda row: "bold green" if row[3] else "")
-
-
-def table(header: tuple[str, ...], rows: list[tuple[str, ...]], style_of=lambda row: "") -> list[Line]:
-    """Left-aligned columns; the same Lines in plain text and through rich."""
-    widths = [max(len(str(c)) for c in col) for col in zip(header, *rows)]
-    fmt = lambda row: "  ".join(f"{str(c):<{w}}" for c, w in zip(row, widths)).rstrip()  # noqa: E731
-    return [[(fmt(header), "bold")]] + [[(fmt(row), style_of(row))] for row in rows]
 
 
 def _name(name: str | None, slot: int) -> str:

@@ -1,9 +1,12 @@
 """A picture of a run (issue 11, `--plot`): position and target over time, lanes below.
 
 The lanes are the buttons held, the LEDs lit and the running macro by name. A
-long fast-forwarded stretch (a day of polling) is drawn compressed to a short
-hatched band labelled with its real length, a broken time axis, so that the
-seconds of action around it stay readable. PNG, SVG and PDF come from
+long fast-forwarded stretch (a day of polling), and the idle time after the
+program ended, is drawn compressed to a short hatched band labelled with its
+real length, a broken time axis, so that the seconds of action around it stay
+readable. The position axis spans where the stage goes; a target far outside
+it (a jog's 9999999, stopped after a moment) is an arrow on the edge with its
+value. A label is drawn only where it fits. PNG, SVG and PDF come from
 matplotlib (the extra `plot`, imported only here and only when drawing); HTML is
 the SVG in a page that zooms and pans (render/plot_html.py).
 """
@@ -12,6 +15,7 @@ from __future__ import annotations
 import io
 import math
 import os
+import re
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass, field
 
@@ -31,7 +35,11 @@ LANES = ("position", "buttons", "LEDs", "macro")
 # on the page: every bar has a 1-pt edge of its colour, which covers finer gaps at any
 # zoom (an SVG zooms its edges too); 36,000 macro changes cost a few thousand bars.
 LANE_STEPS = 3000
+BAND_STEPS = 1000  # the hatching of thousands of bands, about a pixel fine (it costs by the part)
+TICK_ROOM = 0.05  # a piece drawn to scale narrower than this share gets no round ticks inside
 LABEL_WIDTH = 0.03  # a band's label (two lines of 7 pt, turned, boxed): 3% of the time axis
+LABEL_ROOM = 0.015  # a lane label is tried only where this share of the time axis is free
+LABEL_PAD = 4  # pixels: a label fits when it is this much narrower than its room
 
 
 def check_target(path: str) -> None:
@@ -67,6 +75,8 @@ class Trace:
     hazards: list = field(default_factory=list)  # (t, rule)
     end: int = 0
     cut_at: int | None = None  # where recording stopped at CAP
+    ended: int | None = None  # when the program ended (back in direct mode), if it stayed so
+    idle_from: int | None = None  # from here to the end: program ended, stage at rest, no input
 
 
 class PlotObserver:
@@ -107,7 +117,10 @@ class PlotObserver:
             case ev.OutputsChanged(_, pattern):
                 self._pattern(pattern, t)
             case ev.MacroEntered(_, _, label):
+                self.trace.ended = None
                 self._enter(label, t)
+            case ev.ProgramEnded():
+                self.trace.ended = t
             case ev.MacroLeft(back_to=back):
                 self._enter(back, t)
             case ev.MoveStarted(_, _, target, _, segments):
@@ -180,6 +193,8 @@ class PlotObserver:
                 self._switch(since, into, n, False, t_us)
         self._enter(None, t_us)
         self.trace.end = t_us
+        if self.trace.ended is not None and not self.segments:  # a move still running is no idle
+            self.trace.idle_from = max([self.trace.ended, *self.trace.actions[-1:]])
         return self.trace
 
 
@@ -196,13 +211,19 @@ def _last_pattern(shape: tuple) -> int | None:
 
 
 class TimeAxis:
-    """Real time (us) -> drawn seconds: long skipped stretches squeezed to short bands."""
+    """Real time (us) -> drawn seconds: long skipped stretches, and a long idle tail after
+    the program's end (`idle_from`), squeezed to short bands."""
 
-    def __init__(self, skips: list, end: int, actions: list = ()):
+    def __init__(self, skips: list, end: int, actions: list = (), idle_from: int | None = None):
         stretches = [(a, b) for a, b in _merged(skips, sorted(actions)) if b - a >= COMPRESS_US]
         self.stretches = [(a, min(b, end)) for a, b in stretches if a < end]
+        self.idle = None  # the idle tail's stretch, when it is drawn compressed
+        if idle_from is not None and end - idle_from >= COMPRESS_US:
+            self.idle = (max([idle_from, *(b for _, b in self.stretches[-1:])]), end)
+            self.stretches.append(self.idle)
         scaled = max(end - sum(b - a for a, b in self.stretches), 1000)
-        width = scaled * BAND
+        # all bands together no wider than the parts drawn to scale (thousands of skips)
+        width = scaled * min(BAND, 1 / max(len(self.stretches), 1))
         self.real, self.drawn, at = [0.0], [0.0], 0.0
         for a, b in self.stretches:
             at += a - self.real[-1]
@@ -232,14 +253,19 @@ class TimeAxis:
         starts, then round times inside the pieces, as many as fit without overlapping."""
         from matplotlib.ticker import MaxNLocator
 
-        total = self.drawn[-1] or 1.0
-        wanted = [(d0, r0) for r0, r1, d0, d1 in self.pieces()[1:]]
-        for r0, r1, d0, d1 in self.pieces():
+        total, pieces = self.drawn[-1] or 1.0, self.pieces()
+        wanted = [(d0, r0) for r0, r1, d0, d1 in pieces]  # the run's start (0 s) first
+        for r0, r1, d0, d1 in pieces:
+            if d1 - d0 < total * TICK_ROOM:  # its start is all the ticks it has room for
+                continue
             bins = max(1, round(8 * (d1 - d0) / total))
             wanted += [(self._at(r), r) for r in MaxNLocator(bins + 1).tick_values(r0, r1)
                        if r0 - 1e-9 <= r <= r1 + 1e-9]
         placed: list[tuple[float, str]] = []
         for d, r in wanted:
+            # too close to a placed label even for an empty one: not worth wording
+            if any(abs(d - pd) <= total * (len(pt) / 2 + 2) / 110 for pd, pt in placed):
+                continue
             text = duration(r)
             if all(abs(d - pd) > total * ((len(text) + len(pt)) / 2 + 2) / 110 for pd, pt in placed):
                 placed.append((d, text))
@@ -299,7 +325,7 @@ def figure(trace: Trace, title: str = ""):
     plt = _pyplot()
     plt.rcParams["svg.fonttype"] = "none"  # text stays text in an SVG (searchable, testable)
     plt.rcParams["svg.hashsalt"] = "mercmac"  # the same run gives the same file
-    axis = TimeAxis(trace.skips, trace.end, trace.actions)
+    axis = _time_axis(trace)
     inputs = sorted(set(trace.inputs) | {1, 2, 3, 4})
     fig, axes = plt.subplots(4, 1, sharex=True, figsize=(11, 6.5), layout="constrained",
                              gridspec_kw={"height_ratios": [5, 0.45 * len(inputs), 1.8, 0.8]})
@@ -307,16 +333,29 @@ def figure(trace: Trace, title: str = ""):
     _bars(axes[1], trace.inputs, inputs, axis, "tab:blue", "buttons")
     _bars(axes[2], trace.outputs, [1, 2, 3, 4], axis, "tab:orange", "LEDs")
     _macros(axes[3], trace.macros, axis)
+    bands = _spans(axis, axis.stretches)
+    hatch = _hatch(bands, axis)
     for ax in axes:
-        _skipped(ax, axis, label=ax is axes[0])
+        _skipped(ax, hatch)
+    _band_labels(axes[0], axis, bands)
     where, text = axis.ticks()
     axes[-1].set_xticks(where, text)
     axes[-1].set_xlim(0, axis.drawn[-1])
-    broken = " (hatched: fast-forwarded, drawn compressed)" if axis.stretches else ""
-    axes[-1].set_xlabel("time" + broken)
+    axes[-1].set_xlabel("time" + _broken(axis))
     if title:
         fig.suptitle(title, fontsize=11)
     return fig
+
+
+def _time_axis(trace: Trace) -> TimeAxis:
+    return TimeAxis(trace.skips, trace.end, trace.actions, trace.idle_from)
+
+
+def _broken(axis: TimeAxis) -> str:
+    """What the time axis label says about its hatched bands."""
+    kinds = [kind for kind, there in (("fast-forwarded", len(axis.stretches) > bool(axis.idle)),
+                                      ("idle after the program ended", axis.idle)) if there]
+    return f" (hatched: {' or '.join(kinds)}, drawn compressed)" if kinds else ""
 
 
 def _position(ax, trace: Trace, axis: TimeAxis) -> None:
@@ -324,22 +363,100 @@ def _position(ax, trace: Trace, axis: TimeAxis) -> None:
     ax.plot(axis(t), x, color="tab:blue", lw=1.6, label="position")
     t, x = zip(*trace.target)
     ax.step(axis(t), x, where="post", color="tab:red", lw=1, ls="--", label="target")
+    low, high = _y_range(trace)
+    ax.set_ylim(low, high)
+    _clipped_targets(ax, _clipped(trace, (low, high)), axis)
     for t, rule in trace.hazards:
         ax.axvline(float(axis(t)), color="crimson", lw=0.8, ls=":")
         ax.annotate(rule, (float(axis(t)), 0.97), xycoords=("data", "axes fraction"),
                     fontsize=7, color="crimson", rotation=90, va="top", ha="right")
     if trace.cut_at is not None:
-        ax.axvline(float(axis(trace.cut_at)), color="black", lw=1)
-        ax.annotate(" plot cut here (too many changes)", (float(axis(trace.cut_at)), 0.5),
-                    xycoords=("data", "axes fraction"), fontsize=8)
+        _cut(ax, float(axis(trace.cut_at)), axis.drawn[-1])
     ax.set_ylabel("position")
-    low, high = min(x for _, x in trace.position), max(x for _, x in trace.position)
-    if high - low < 2:  # standing still: a sensible scale around it, whole steps
-        ax.set_ylim(low - 10, high + 10)
     ax.yaxis.get_major_locator().set_params(integer=True)
     ax.ticklabel_format(axis="y", style="plain", useOffset=False)
     ax.grid(alpha=0.3)
-    ax.legend(loc="upper left", fontsize=8, framealpha=0.8)
+    # above the axes: inside, it would cover the start of the run and its target arrows
+    ax.legend(loc="lower right", bbox_to_anchor=(1, 1), ncols=2, fontsize=8, frameon=False,
+              borderaxespad=0.1)
+
+
+def _cut(ax, x: float, total: float) -> None:
+    """The line where recording stopped, its note on the side with room (never widening
+    the figure: the note is left out of the layout)."""
+    ax.axvline(x, color="black", lw=1)
+    right = x > total / 2
+    note = ax.annotate("plot cut here (too many changes)", (x, 0.5), xytext=(-4 if right else 4, 0),
+                       xycoords=("data", "axes fraction"), textcoords="offset points",
+                       ha="right" if right else "left", fontsize=8)
+    note.set_in_layout(False)
+
+
+def _y_range(trace: Trace) -> tuple[float, float]:
+    """The position axis: where the stage goes, with the targets near it; a margin of 5%."""
+    xs = [x for _, x in trace.position]
+    low, high = min(xs), max(xs)
+    reach = max(high - low, 10)  # a target further out than the travel itself is clipped
+    near = [x for _, x in trace.target if low - reach <= x <= high + reach]
+    low, high = min([low, *near]), max([high, *near])
+    if high - low < 2:  # standing still: a sensible scale around it, whole steps
+        return low - 10, high + 10
+    return low - (high - low) * 0.05, high + (high - low) * 0.05
+
+
+def _clipped(trace: Trace, shown: tuple[float, float]) -> list[tuple[int, int]]:
+    """The targets set outside the position axis: (t, target)."""
+    low, high = shown
+    return [(t, x) for t, x in trace.target[1:-1] if not low <= x <= high]
+
+
+def _clipped_targets(ax, targets: list, axis: TimeAxis) -> None:
+    """Each target beyond the axis as an arrow on its edge, pointing out; its value beside
+    it where there is room before the next one."""
+    if not targets:
+        return
+    at = axis([t for t, _ in targets]).tolist()
+    up = [target > ax.get_ylim()[0] for _, target in targets]  # outside: above or below
+    for edge in (True, False):
+        _arrows(ax, [x for x, above in zip(at, up) if above == edge], edge)
+    total = axis.drawn[-1] or 1.0
+    for x, until, above, (_, target) in zip(at, at[1:] + [total], up, targets):
+        if until - x >= total * LABEL_ROOM:
+            _fit(_target_label(ax, x, target, above), (x, until), (f"target {target}",))
+
+
+def _arrows(ax, xs: list, up: bool) -> None:
+    """Arrow heads on the top (or bottom) edge at xs, in one artist."""
+    if xs:  # on the edge, outside the clip; left out of the layout like the axes' spines
+        ax.plot(xs, [1 if up else 0] * len(xs), ls="none", marker="^" if up else "v", ms=8,
+                color="tab:red", transform=ax.get_xaxis_transform(), clip_on=False,
+                zorder=5)[0].set_in_layout(False)
+
+
+def _target_label(ax, x: float, target: int, up: bool):
+    return ax.annotate(f"target {target}", (x, 1 if up else 0), xytext=(5, -4 if up else 4),
+                       xycoords=ax.get_xaxis_transform(), textcoords="offset points",
+                       va="top" if up else "bottom", fontsize=7, color="tab:red",
+                       bbox={"facecolor": "white", "edgecolor": "none", "pad": 1,
+                             "alpha": 0.6})  # readable, and the curve shows through
+
+
+def _fit(label, room: tuple[float, float], texts: tuple[str, ...]) -> None:
+    """Draw `label` with the first of `texts` whose width fits in `room` (time axis
+    from, to), or not at all: whether it fits is known only when drawing, after the
+    layout, so the label's own draw is wrapped (its text is then what was drawn)."""
+    plain = label.draw
+
+    def draw(renderer):
+        left, right = label.axes.transData.transform([(room[0], 0), (room[1], 0)])[:, 0]
+        for text in texts:
+            label.set_text(text)
+            if label.get_window_extent(renderer).width + LABEL_PAD <= right - left:
+                return plain(renderer)
+        label.set_text("")
+
+    label.set_in_layout(False)
+    label.draw = draw
 
 
 def _bars(ax, lanes: dict, rows: list, axis: TimeAxis, color: str, name: str) -> None:
@@ -407,30 +524,47 @@ def _macros(ax, macros: list, axis: TimeAxis) -> None:
     _lane(ax, spans, [color[label] for *_, label in macros], (0.1, 0.8), axis)
     total = axis.drawn[-1] or 1.0
     for (x0, width), (*_, label) in zip(spans, macros):
-        if width > total * 0.035:
-            ax.text(x0 + width / 2, 0.5, label, ha="center", va="center", fontsize=7, clip_on=True)
+        if width > total * LABEL_ROOM:
+            text = ax.text(x0 + width / 2, 0.5, label, ha="center", va="center", fontsize=7)
+            _fit(text, (x0, x0 + width), (label, *re.findall(r"\((MC\d+)\)$", label)))
     ax.set_yticks([])
     ax.set_ylim(0, 1)
     ax.set_ylabel("macro", rotation=0, ha="right", va="center")
     ax.grid(axis="x", alpha=0.3)
 
 
-def _skipped(ax, axis: TimeAxis, label: bool) -> None:
-    """The compressed stretches hatched across the axes: one path of many parts, hatched
-    once (hatching each band on its own costs milliseconds a band)."""
-    from matplotlib.patches import PathPatch
+def _hatch(bands: list, axis: TimeAxis):
+    """The compressed stretches as one path of many parts, for every lane (hatching each
+    band on its own costs milliseconds a band); None without any."""
     from matplotlib.path import Path
 
-    bands = _spans(axis, axis.stretches)
-    if bands:
-        drawn, _ = _drawable(bands, [None] * len(bands), axis)
-        parts = [Path([(x, 0), (x, 1), (x + w, 1), (x + w, 0), (x, 0)], closed=True)
-                 for x, w in drawn]
+    if not bands:
+        return None
+    parts = [Path([(x, 0), (x, 1), (x + w, 1), (x + w, 0), (x, 0)], closed=True)
+             for x, w in _band_parts(bands, axis)]
+    return Path.make_compound_path(*parts)
+
+
+def _band_parts(bands: list, axis: TimeAxis) -> list:
+    """More than BAND_STEPS bands drawn no finer, each block hatched in the share of its
+    time that was skipped: what happened between the bands stays visible beside them."""
+    if len(bands) <= BAND_STEPS:
+        return bands
+    gaps = [(x + w, after - x - w) for (x, w), (after, _) in zip(bands, bands[1:])]
+    spans = [span for pair in zip(bands, gaps) for span in pair] + bands[-1:]
+    spans, skipped = _coarse(spans, [True, False] * len(gaps) + [True],
+                             (axis.drawn[-1] or 1.0) / BAND_STEPS)
+    return [span for span, band in zip(spans, skipped) if band]
+
+
+def _skipped(ax, hatch) -> None:
+    """The compressed stretches hatched across the axes, above the lanes."""
+    from matplotlib.patches import PathPatch
+
+    if hatch is not None:
         # an artist, not a patch: the time axis is set, and its limits would walk every part
-        ax.add_artist(PathPatch(Path.make_compound_path(*parts), transform=ax.get_xaxis_transform(),
-                                facecolor="white", edgecolor="gray", hatch="///", lw=0, zorder=3))
-    if label:
-        _band_labels(ax, axis, bands)
+        ax.add_artist(PathPatch(hatch, transform=ax.get_xaxis_transform(), facecolor="white",
+                                edgecolor="gray", hatch="///", lw=0, zorder=3))
 
 
 def _band_labels(ax, axis: TimeAxis, bands: list) -> None:
@@ -440,7 +574,8 @@ def _band_labels(ax, axis: TimeAxis, bands: list) -> None:
         if x + w / 2 - placed < total * LABEL_WIDTH:
             continue
         placed = x + w / 2
-        ax.text(placed, 0.5, f"{span(b - a)}\nfast-forwarded",
+        what = "idle: program ended" if (a, b) == axis.idle else "fast-forwarded"
+        ax.text(placed, 0.5, f"{span(b - a)}\n{what}",
                 transform=ax.get_xaxis_transform(), ha="center", va="center", fontsize=7,
                 rotation=90, zorder=4, bbox={"facecolor": "white", "edgecolor": "gray"})
 
@@ -470,7 +605,7 @@ def write(path: str, trace: Trace, title: str = "") -> None:
 
 def data(trace: Trace) -> dict:
     """The lanes as plain numbers (ms), for the HTML page's readers and tests."""
-    ms = 1e-3
+    ms, shown, axis = 1e-3, _y_range(trace), _time_axis(trace)
     return {
         "lanes": list(LANES),
         "end_ms": trace.end * ms,
@@ -481,4 +616,10 @@ def data(trace: Trace) -> dict:
         "macro": [[a * ms, b * ms, label] for a, b, label in trace.macros],
         "fast_forwarded": [[a * ms, b * ms, passes, loop] for a, b, passes, loop in trace.skips],
         "hazards": [[t * ms, rule] for t, rule in trace.hazards],
+        "ended_ms": None if trace.ended is None else trace.ended * ms,
+        # as drawn: the position axis, the targets beyond it (arrows), the compressed bands
+        "position_range": [round(v, 1) for v in shown],
+        "clipped_targets": [[t * ms, x] for t, x in _clipped(trace, shown)],
+        "compressed": [[a * ms, b * ms, "idle" if (a, b) == axis.idle else "fast-forwarded"]
+                       for a, b in axis.stretches],
     }

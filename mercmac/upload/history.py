@@ -158,9 +158,9 @@ def lookup(macros: dict[int, str], *, port: str | None = None,
     return recall(macros, records(), port=port, address=address).record
 
 
-def _rebuilds(found: Record, wanted: dict[int, str]) -> str:
-    """'' when the recorded source builds to `wanted` today, as `flash` built it (its own
-    `target`, else the controller's model); else why not, in a few words."""
+def built(found: Record):
+    """The recorded source compiled today as `flash` built it: with its own `target`,
+    else the controller's model (a compiler Compilation)."""
     from mercmac.compiler import compile_source
     from mercmac.source import Source
 
@@ -168,10 +168,17 @@ def _rebuilds(found: Record, wanted: dict[int, str]) -> str:
     compiled = compile_source(source)
     if compiled.program is not None and compiled.program.target is None and found.model:
         compiled = compile_source(source, found.model)
+    return compiled
+
+
+def _rebuilds(found: Record, wanted: dict[int, str]) -> str:
+    """'' when the recorded source builds to `wanted` today, as `flash` built it; else why
+    not, in a few words."""
+    compiled = built(found)
     if compiled.program is None or compiled.report.has_errors:
         return "it has errors with this mercmac"
-    built = {slot: body for slot, body in map(mdtext.split_md, compiled.program.md_lines())}
-    if _normal(built) != wanted:
+    lines = {slot: body for slot, body in map(mdtext.split_md, compiled.program.md_lines())}
+    if _normal(lines) != wanted:
         return "this mercmac lowers it to other macros"
     return ""
 
