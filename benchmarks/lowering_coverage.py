@@ -31,7 +31,7 @@ from collections import Counter
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # mercmac and the tests' helpers
 
 from mercmac.compiler import compile_source  # noqa: E402
 from mercmac.compiler.ast_builder import build  # noqa: E402
@@ -39,7 +39,7 @@ from mercmac.compiler.checks import check_module  # noqa: E402
 from mercmac.compiler.parse import parse  # noqa: E402
 from mercmac.diagnostics import Report, Severity  # noqa: E402
 from mercmac.source import Source  # noqa: E402
-from semantics import firmware_trace, high_level_trace, same_effects  # noqa: E402
+from helpers.semantics import firmware_trace, high_level_trace, same_effects  # noqa: E402
 
 
 class Gen:

@@ -23,7 +23,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))  # lsp_wire: a client that frames LSP itself
+sys.path.insert(0, str(ROOT / "tests"))  # helpers.lsp_wire: a client that frames LSP itself
 
 EXAMPLES = ROOT / "examples" / "macros"
 
@@ -101,7 +101,7 @@ def main() -> None:
 
 def server_latency(text: str, edits: int = 5, burst: int = 10) -> None:
     """The large document through a real `mercmac lsp`: seconds to each version's diagnostics."""
-    from lsp_wire import INITIALIZE, Server, frame, notification
+    from helpers.lsp_wire import INITIALIZE, Server, frame, notification
 
     uri, mb = "file:///big.mcm", len(text.encode()) / 1e6
     server = Server()
@@ -123,7 +123,7 @@ def server_latency(text: str, edits: int = 5, burst: int = 10) -> None:
 
 def _keystroke(uri: str, version: int, line: int) -> dict:
     """A didChange typing one space at the start of `line`."""
-    from lsp_wire import notification
+    from helpers.lsp_wire import notification
 
     at = {"line": line, "character": 0}
     return notification("textDocument/didChange", {
@@ -133,7 +133,7 @@ def _keystroke(uri: str, version: int, line: int) -> dict:
 
 def _timed(server, version: int, *messages: dict) -> float:
     """Seconds from writing `messages` to the diagnostics of document `version`."""
-    from lsp_wire import frame
+    from helpers.lsp_wire import frame
 
     start = time.perf_counter()
     server.write(b"".join(frame(m) for m in messages))

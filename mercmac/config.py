@@ -23,7 +23,7 @@ import reprlib
 from typing import NamedTuple
 
 from mercmac.commands import MODELS
-from mercmac.errors import UsageError
+from mercmac.errors import SettingsError
 
 KEYS = ("target", "select", "ignore")
 # Only a pyproject.toml that names mercmac is parsed: the others cost one read and no TOML
@@ -76,8 +76,8 @@ def _read_folder(folder: str) -> Settings | None:
     if os.path.lexists(own):
         table = _load(own, _read(own))
         if isinstance(table.get("tool"), dict) and "mercmac" in table["tool"]:
-            raise UsageError(f"[tool.mercmac] in {own}: a mercmac.toml holds the "
-                             "settings at its top level", hint="remove the [tool.mercmac] line")
+            raise SettingsError(f"[tool.mercmac] in {own}: a mercmac.toml holds the "
+                                "settings at its top level", hint="remove the [tool.mercmac] line")
         return _parse(own, table)
     project = os.path.join(folder, "pyproject.toml")
     if os.path.lexists(project):
@@ -95,15 +95,15 @@ def _project_settings(path: str, document: dict) -> Settings | None:
     if table is None:
         return None
     if isinstance(table, list):
-        raise UsageError(f"[[tool.mercmac]] in {path} is an array of tables: mercmac "
-                         "reads one table", hint="write [tool.mercmac] with single brackets")
+        raise SettingsError(f"[[tool.mercmac]] in {path} is an array of tables: mercmac "
+                            "reads one table", hint="write [tool.mercmac] with single brackets")
     return _parse(path, _table(table, "tool.mercmac", path), "[tool.mercmac] of ")
 
 
 def _table(value, key: str, path: str) -> dict:
-    """VALUE, when it is a TOML table; else the usage error that says what it is."""
+    """VALUE, when it is a TOML table; else the SettingsError that says what it is."""
     if not isinstance(value, dict):
-        raise UsageError(f"{key} in {path} is {_toml_type(value)}, not a table")
+        raise SettingsError(f"{key} in {path} is {_toml_type(value)}, not a table")
     return value
 
 
@@ -122,18 +122,18 @@ def _read(path: str) -> str:
     try:
         data = read_bytes(path)
     except OSError as e:
-        raise UsageError(f"cannot read the settings in {path}: {reason(e)}") from None
+        raise SettingsError(f"cannot read the settings in {path}: {reason(e)}") from None
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        raise UsageError(f"cannot read the settings in {path}: it starts with a "
-                         "UTF-16 byte-order mark, and TOML files are UTF-8",
-                         hint="save it as UTF-8")
+        raise SettingsError(f"cannot read the settings in {path}: it starts with a "
+                            "UTF-16 byte-order mark, and TOML files are UTF-8",
+                            hint="save it as UTF-8")
     try:
         return data.decode("utf-8-sig")  # a leading UTF-8 BOM is read past (module docstring)
     except UnicodeDecodeError as e:
         line = data[:e.start].count(b"\n") + 1
-        raise UsageError(f"cannot read the settings in {path}: byte "
-                         f"0x{data[e.start]:02X} at line {line} is not UTF-8, and TOML files "
-                         "are UTF-8", hint="save it as UTF-8") from None
+        raise SettingsError(f"cannot read the settings in {path}: byte "
+                            f"0x{data[e.start]:02X} at line {line} is not UTF-8, and TOML files "
+                            "are UTF-8", hint="save it as UTF-8") from None
 
 
 def _load(path: str, text: str) -> dict:
@@ -144,10 +144,10 @@ def _load(path: str, text: str) -> dict:
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise UsageError(f"{path} is not valid TOML: {e}") from None
+        raise SettingsError(f"{path} is not valid TOML: {e}") from None
     except RecursionError:  # tomllib reads nested arrays and tables by recursion
-        raise UsageError(f"{path} is not valid settings: its arrays or tables are "
-                         "nested too deeply to read") from None
+        raise SettingsError(f"{path} is not valid settings: its arrays or tables are "
+                            "nested too deeply to read") from None
 
 
 def _parse(path: str, table: dict, where: str = "") -> Settings:
@@ -155,13 +155,13 @@ def _parse(path: str, table: dict, where: str = "") -> Settings:
     unknown = sorted(set(table) - set(KEYS))
     if unknown:
         keys = ", ".join(reprlib.repr(k) for k in unknown[:5]) + (", ..." if unknown[5:] else "")
-        raise UsageError(f"unknown setting{'s' if len(unknown) > 1 else ''} "
-                         f"{keys} in {where}{path}",
-                         hint=f"mercmac knows {', '.join(KEYS)}")
+        raise SettingsError(f"unknown setting{'s' if len(unknown) > 1 else ''} "
+                            f"{keys} in {where}{path}",
+                            hint=f"mercmac knows {', '.join(KEYS)}")
     target = table.get("target")
     if target is not None and (not isinstance(target, str) or target.upper() not in MODELS):
-        raise UsageError(f"target = {reprlib.repr(target)} in {where}{path} is not a model: "
-                         f"use {' or '.join(MODELS)}")
+        raise SettingsError(f"target = {reprlib.repr(target)} in {where}{path} is not a model: "
+                            f"use {' or '.join(MODELS)}")
     return Settings(path, target.upper() if target else None,
                     _rule_list(table, "select", path, where),
                     _rule_list(table, "ignore", path, where))
@@ -174,6 +174,6 @@ def _rule_list(table: dict, key: str, path: str, where: str) -> tuple[str, ...] 
     if isinstance(value, str):
         value = [value]
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-        raise UsageError(f"{key} in {where}{path} must be a list of rule codes or names, "
-                         f'e.g. {key} = ["MM011", "undefined-macro"]')
+        raise SettingsError(f"{key} in {where}{path} must be a list of rule codes or names, "
+                            f'e.g. {key} = ["MM011", "undefined-macro"]')
     return tuple(value)

@@ -26,7 +26,7 @@ NAME = r"[A-Za-z_][A-Za-z0-9_.]*"
 INT = r"[+-][ \t]*[0-9]+|[0-9]+"
 WORD = r"[A-Za-z]+\??"  # MNEMONIC: a known one or not
 DURATION = r"[0-9]+(?:\.[0-9]+)?[ \t]*(?i:ms|min|s|h|d)(?![A-Za-z0-9_])"
-RAW_HEADER = r"\[[ \t]*(?i:MC)[ \t]*[+-]?[ \t]*[0-9]+[ \t]*\]"
+RAW_HEADER = mdtext.RAW_HEADER  # `[MCnn]`: the one pattern, grammar.lark's
 MODEL = r"(?i:C-?[0-9]{3})"
 COMMENT = r"//[^\r\n]*"
 

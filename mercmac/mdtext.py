@@ -8,6 +8,11 @@ validation `mercmac check` applies to a native command (both call `validate`);
 command line the uploader sends. The compiler, the VM, the emulator and the
 uploader all read and write MD text here.
 
+Macro listings, too: `listed` reads the header of a line that names a macro by its slot
+(a `[MCnn]` block, an `MDn,` definition, a line of a TM report), `RAW_HEADER` is the
+pattern of a raw block's header that highlighting shares, and `slot_name` and `tm_line`
+write a slot's name. fmt, the parser, the decompiler and the uploader read them here.
+
 Blanks: "Both uppercase and lowercase characters are valid, and spaces are
 allowed" (MS176E §5.2): a command is what its characters say with the blanks
 dropped (`m r 5` is MR5, `EM + 9` is EM9). Where that reading is no command, the
@@ -17,9 +22,11 @@ from __future__ import annotations
 
 import functools
 import re
+from enum import Enum
 from typing import Iterable, NamedTuple
 
 from mercmac.commands import Arg, Command, Mnemonic, lookup, nearest
+from mercmac.ops import Op, Role
 
 MAX_COMMANDS = 16  # MS176E §3.8: "Each macro can contain up to 16 base commands"
 # Longer numbers are outside every range of MS176E §6.4, and int() refuses more than
@@ -65,7 +72,7 @@ class Finding(NamedTuple):
 class Checked(NamedTuple):
     """A validated command: its op when it may stand, and every finding."""
 
-    op: object  # mercmac.compiler.program.Op | None
+    op: Op | None
     findings: tuple[Finding, ...]
 
 
@@ -94,7 +101,7 @@ class Problem(NamedTuple):
 class ParsedLine(NamedTuple):
     """A line read as the controller reads it: its ops and what is wrong with it."""
 
-    ops: tuple
+    ops: tuple[Op, ...]
     problems: tuple[Problem, ...]
 
     @property
@@ -219,7 +226,7 @@ def parse_line(text: str, *, model: str | None = None, stored: bool = True,
         if checked.op is not None:
             ops.append(checked.op._replace(span=None))
     if stored and len(items) > MAX_COMMANDS:
-        macro = "the line" if slot is None else f"MC{slot:02d}"
+        macro = "the line" if slot is None else slot_name(slot)
         problems.append(Problem("too-many-commands", 0, len(text), "", (
             ("macro", macro), ("count", len(items)), ("max", MAX_COMMANDS))))
     return ParsedLine(tuple(ops), tuple(problems))
@@ -273,8 +280,6 @@ def _validate(word: str, value, model: str | None, stored: bool, slot: int | Non
         findings.append(Finding("default-argument", "command", "", (
             ("mnemonic", spec.mnemonic), ("default", spec.default))))
     findings += _use(spec, model, stored, slot)
-    from mercmac.compiler.program import Op, Role
-
     role = Role.RAW if spec.mnemonic == Mnemonic.EM else Role.NONE
     return Checked(Op(spec.mnemonic, arg, None, role), tuple(findings))
 
@@ -305,12 +310,14 @@ def _unknown(word: str) -> Finding:
             ("expects", spec.expects()), ("placeholder", word[2:])), skip=2)
     guess = nearest(word.upper())
     hint = f"; did you mean {guess}?" if guess else ""
-    return Finding("unknown-command", "word", "", (("word", word), ("hint", hint)))
+    # `guess` is data for the fix (compiler/checks.py); `hint` says it
+    return Finding("unknown-command", "word", "", (("word", word), ("hint", hint),
+                                                   ("guess", guess)))
 
 
 # -- writing ------------------------------------------------------------------------------------
 
-def format_ops(ops: Iterable) -> str:
+def format_ops(ops: Iterable[Op]) -> str:
     """Ops as a stored line: 'MR5000,WS100' (MS176E §5.3)."""
     return ",".join(op.text for op in ops)
 
@@ -328,15 +335,75 @@ def normal(text: str | None) -> str:
     return text if parsed.errors else format_ops(parsed.ops)
 
 
+# -- macro listings: `[MCnn]` blocks, `MDn,` definitions and TM reports ----------------------
+
+def slot_name(slot: int) -> str:
+    """'MC05': a macro named by its slot, as MMCRun writes it (MS176E §3.8.6, Example 4)."""
+    return f"MC{slot:02d}"
+
+
+def tm_line(slot: int, line: str | None = None) -> str:
+    """'MC005 MR5000': a line of a TM or TZ report (MS176E §6.4 TM); a bare 'MC005' for None."""
+    return f"MC{slot:03d}" if line is None else f"MC{slot:03d} {line}"
+
+
+# A raw block's header in a .mcm file (MS176E §3.8.6): grammar.lark's RAW_LINE up to its `]`
+# (tests/test_listings.py keeps them equal), written so that Pygments and Oniguruma read it too.
+_RAW = r"\[[ \t]*(?i:MC)[ \t]*{}[ \t]*\]"
+_SLOT = r"[+-]?[ \t]*\d+"
+RAW_HEADER = _RAW.format(_SLOT)
+
+
+class Form(Enum):
+    """The three ways a macro's line is listed."""
+
+    RAW = "[MCnn]"  # a block of a .mcm file, as MMCRun saves it (MS176E §3.8.6)
+    MD = "MDn,"  # a definition (MS176E §3.8.1)
+    TM = "MCnnn"  # a line of a TM or TZ report: "MC001 MR55555" (MS176E §6.4 TM)
+
+
+class Listed(NamedTuple):
+    """One line of a macro listing: its form, its slot and what follows the header."""
+
+    form: Form
+    slot: int | None  # None: no number (more than MAX_DIGITS digits)
+    header: int  # the header's length: the commands start there
+    body: str  # the rest of the line (a `[MCnn]` block's may end in a `//` comment)
+
+
+_LISTED = re.compile(
+    _RAW.format(f"(?P<RAW>{_SLOT})")
+    + r"|MD[ \t]*(?P<MD>[+-]?[ \t]*[0-9]+)[ \t]*(?:,|$)"
+    # TM writes three digits; one or two before a blank are read too (SPEC §4)
+    + r"|MC\s*(?P<TM>[0-9]{3}|[0-9]{1,2}(?=\s|$))(?:\s+|$)", re.IGNORECASE)
+_FORMS = (None, Form.RAW, Form.MD, Form.TM)  # by the group of the form's slot number
+
+
+def listed(line: str) -> Listed | None:
+    """LINE read as a line of a macro listing; None when it starts with no header."""
+    m = _LISTED.match(line)
+    if m is None:
+        return None
+    digits, end = m.group(m.lastindex), m.end()
+    # `05`, as almost every header writes it, without number()'s blanks and signs (fmt
+    # reads each header of a file three times: benchmarks/fmt_large.py)
+    slot = int(digits) if digits.isdecimal() and digits.isascii() and len(digits) < 4 else \
+        number(digits)
+    return Listed(_FORMS[m.lastindex], slot, end, line[end:])
+
+
 def split_md(line: str) -> tuple[int | None, str]:
     """'MD5,MR5000,WS100' -> (5, 'MR5000,WS100'); the slot is None when it is no number."""
-    head, _, body = canonical(line).partition(",")
-    return number(head[2:]) if head.startswith(Mnemonic.MD) else None, body
+    text = canonical(line)
+    found = listed(text)
+    if found is not None and found.form is Form.MD:
+        return found.slot, found.body
+    return None, text.partition(",")[2]
 
 
 # -- wire commands (without their CR: mercmac.upload.protocol.command frames them) --------------
 
-def md(slot: int, line: str | Iterable) -> str:
+def md(slot: int, line: str | Iterable[Op]) -> str:
     """MDn,...: define macro n (MS176E §3.8.1); `line` is text or ops."""
     body = line if isinstance(line, str) else format_ops(line)
     return f"{Mnemonic.MD}{slot},{body}" if body else f"{Mnemonic.MD}{slot}"

@@ -36,10 +36,11 @@ import signal
 import stat
 import tempfile
 import threading
+from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Iterator, NamedTuple
 
-from mercmac.errors import UsageError
+from mercmac.errors import InputError
 
 TEMP_PREFIX = ".mercmac-"
 TEMP_SUFFIX = ".tmp"
@@ -53,7 +54,7 @@ _KINDS = (
 )
 
 
-class OutputError(UsageError):
+class OutputError(InputError):
     """A file that cannot or must not be written; exit code 2, nothing changed."""
 
 
@@ -122,11 +123,28 @@ def _read_only(target: Path, st: os.stat_result) -> bool:
 
 
 @contextlib.contextmanager
-def replacing(path: str | os.PathLike, *, binary: bool = False, encoding: str = "utf-8",
-              make_parents: bool = False, durable: bool = True,
-              expect: Snapshot | None = None) -> Iterator[IO]:
+def replacing(path: str | os.PathLike, **how) -> Iterator[IO]:
     """A file object on a temporary file that replaces PATH when the block ends normally
-    (in place when PATH has hard links); with EXPECT, only if PATH still holds that."""
+    (in place when PATH has hard links); HOW as for `drafting`."""
+    with drafting(path, **how) as draft:
+        yield draft.file
+
+
+@dataclass(slots=True)
+class Draft:
+    """The new file `drafting` writes, and whether it is to replace the old one."""
+
+    file: IO
+    keep: bool = True  # False: the old file stays (a VCD cut short by Ctrl-C is no dump to keep)
+
+
+@contextlib.contextmanager
+def drafting(path: str | os.PathLike, *, binary: bool = False, encoding: str = "utf-8",
+             make_parents: bool = False, durable: bool = True,
+             expect: Snapshot | None = None) -> Iterator[Draft]:
+    """`replacing`, with the last word left to the caller: a Draft whose file replaces PATH
+    when the block ends normally, unless `keep` was set False; with EXPECT, only if PATH
+    still holds that."""
     target = writable_target(path, make_parents=make_parents)
     with _terminable(path):
         try:
@@ -141,11 +159,15 @@ def replacing(path: str | os.PathLike, *, binary: bool = False, encoding: str = 
             except BaseException:
                 os.close(fd)
                 raise
+            draft = Draft(f)
             with f:
-                yield f
+                yield draft
                 f.flush()
-                if durable:
+                if durable and draft.keep:
                     os.fsync(f.fileno())
+            if not draft.keep:  # the caller let it go: the old file stays as it was
+                _remove(tmp)
+                return
             _unchanged(target, expect, path)
             _put(tmp, target, path)
         except OSError as e:

@@ -8,7 +8,7 @@ import stat
 import sys
 from typing import NamedTuple
 
-from mercmac.errors import UsageError
+from mercmac.errors import InputError
 from mercmac.outfile import kind
 
 # The one definition of a line end in mercmac (SPEC §5): LF, CRLF or a lone CR, mixed freely,
@@ -151,7 +151,7 @@ class Encoding(str):
         return data[len(self.bom):].decode(self, errors)
 
 
-class EncodingError(UsageError):
+class EncodingError(InputError):
     """Bytes that do not read in the file's encoding: writing the text back would change them."""
 
 

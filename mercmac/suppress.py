@@ -14,7 +14,7 @@ import reprlib
 from typing import Iterable, NamedTuple
 
 from mercmac.diagnostics import RULES, Diagnostic, Report, rule
-from mercmac.errors import UsageError
+from mercmac.errors import SettingsError
 from mercmac.source import Source, Span, split_lines
 
 # `// mercmac: ignore` (every rule) or `// mercmac: ignore[MM011, undefined-macro]`, in any
@@ -44,8 +44,8 @@ def rule_set(keys: Iterable[str], option: str) -> frozenset[str]:
         try:
             found.add(rule(key).code)
         except KeyError:
-            raise UsageError(f"{option}: no rule {reprlib.repr(key)}",
-                             hint="`mercmac explain` lists the codes and names") from None
+            raise SettingsError(f"{option}: no rule {reprlib.repr(key)}",
+                                hint="`mercmac explain` lists the codes and names") from None
     return frozenset(found)
 
 
@@ -54,9 +54,9 @@ def selection(keys: Iterable[str], option: str) -> frozenset[str]:
     and pass, which is never what `--select ''` or `select = []` meant (issue 20)."""
     codes = rule_set(keys, option)
     if not codes:
-        raise UsageError(f"{option} names no rule, so nothing would be reported",
-                         hint="name rules by code or name (MM011, undefined-macro); "
-                              "leave the selection out to report every rule")
+        raise SettingsError(f"{option} names no rule, so nothing would be reported",
+                            hint="name rules by code or name (MM011, undefined-macro); "
+                                 "leave the selection out to report every rule")
     return codes
 
 

@@ -1,4 +1,7 @@
-"""Durations (`20ms`, `1.5s`, `1500d`) and button scripts (SPEC §5 `--buttons`)."""
+"""Durations (`20ms`, `1.5s`, `1500d`), button scripts (SPEC §5 `--buttons`), and the one way
+times are written for people: `format_span` (a length) and `format_clock` (a time on the run's
+clock). Every number goes with its unit after a space, as `--until` takes it: `1.5 s`, `31.7 min`,
+`1,500 d`; a clock from 1000 s on reads `1 d 1:01:01.5`."""
 from __future__ import annotations
 
 import math
@@ -43,12 +46,87 @@ def parse_duration(text: str) -> int:
     return int(value)
 
 
-def format_duration(ms: int) -> str:
-    """A duration with its unit, in the largest unit it is whole in: '3 ms', '10 s', '1500 d'."""
-    for unit, size in reversed(UNIT_MS.items()):
-        if ms and ms % size == 0:
-            return f"{ms // size:,} {unit}"
-    return f"{ms:,} ms"
+def format_span(t_us: float, digits: int | None = 3, parts: int = 1) -> str:
+    """A length of time in the largest unit it reaches: '39 ms', '1.5 s', '31.7 min', '1,500 d'.
+
+    `digits` significant digits, rounded (a span that rounds up to the next unit is said in
+    it: 59.99 s is '1 min'); None: every digit, exact to the microsecond ('1.001 s', '90 s' is
+    '1.5 min'), which `parse_duration` reads back. `parts=2`: whole units from the largest
+    down, truncated: '23 h 59 min' (a plot's band, where '1 d' would overstate it).
+    """
+    if t_us == math.inf:
+        return "forever"
+    if parts > 1 and t_us >= _UNITS_US[2][1]:  # below a minute one unit says it
+        return _in_parts(t_us, parts)
+    return _rounded(t_us, digits) if digits else _exact(t_us)
+
+
+def format_clock(t_us: float, places: int | None = None, fixed: bool = False) -> str:
+    """A time on the run's clock: '1.5 s', '999.999 s', then '0:16:40', '1 d 1:01:01.5'.
+
+    `places` decimals of a second, or None: as many as it has, to the microsecond (the
+    machine's resolution). `fixed`: a line redrawn in place keeps its width: always
+    HH:MM:SS, days as '3d' (test_ff_shift pins this spelling of the progress line).
+    """
+    if t_us == math.inf:
+        return "never"
+    step = 1 if places is None else 10 ** (6 - places)
+    # rounded once, exactly, half up, before the form is chosen: 999.9996 s at 3 places is
+    # 0:16:40.000 (a fraction of a microsecond is not rounded first: 1.2324996 s is 1.232 s)
+    exact = int(t_us) if float(t_us).is_integer() else Fraction(t_us)
+    whole, us = divmod((2 * exact + step) // (2 * step) * step, 1_000_000)
+    tail = _fraction(us, places)
+    if whole < CLOCK_IN_SECONDS and not fixed:
+        return f"{whole}{tail} s"
+    days, rest = divmod(whole, 86_400)
+    hours, rest = divmod(rest, 3600)
+    text = f"{hours:0{2 if fixed else 1}d}:{rest // 60:02d}:{rest % 60:02d}{tail}"
+    if not days:
+        return text
+    return f"{days}d {text}" if fixed else f"{days:,} d {text}"
+
+
+def _fraction(us: int, places: int | None) -> str:
+    """'.5' (places None: trailing zeros dropped), '.500' (3 places), '' (0 places or none)."""
+    digits = f"{us:06d}"
+    shown = digits.rstrip("0") if places is None else digits[:places]
+    return f".{shown}" if shown else ""
+
+
+# Seconds read best up to a few minutes (a timeline of 360.000 s stays in seconds, and its
+# column keeps its width); H:MM:SS from 1000 s, where seconds would need a fourth digit.
+CLOCK_IN_SECONDS = 1000
+_UNITS_US = tuple((unit, size * 1000) for unit, size in reversed(UNIT_MS.items()))  # d .. ms
+
+
+def _rounded(t_us: float, digits: int) -> str:
+    for i, (unit, size) in enumerate(_UNITS_US):
+        value = float(f"{t_us / size:.{digits}g}")
+        if value >= 1 or unit == "ms":
+            if i and value * size >= _UNITS_US[i - 1][1]:  # 59.99 s rounds to 60 s: 1 min
+                return _rounded(_UNITS_US[i - 1][1], digits)
+            return f"{t_us / size:,.0f} {unit}" if value >= 10 ** digits else f"{value:g} {unit}"
+    raise AssertionError("unreachable: ms takes every span")
+
+
+def _exact(t_us: float) -> str:
+    """In the largest unit it is at least one of with at most three decimals: '1.5 min'."""
+    for unit, size in _UNITS_US:
+        value = Fraction(t_us) / size
+        if unit == "ms" or (value >= 1 and (value * 1000).denominator == 1):
+            return f"{float(value):,.3f}".rstrip("0").rstrip(".") + f" {unit}"
+    raise AssertionError("unreachable: ms takes every span")
+
+
+def _in_parts(t_us: float, parts: int) -> str:
+    """'23 h 59 min', '2 min 5 s', '1 d': whole units, zeros left out."""
+    start = next(i for i, (_, size) in enumerate(_UNITS_US) if t_us >= size)
+    words = []
+    for unit, size in _UNITS_US[start:start + parts]:
+        n, t_us = divmod(t_us, size)
+        if n:
+            words.append(f"{int(n):,} {unit}")
+    return " ".join(words)
 
 
 def _too_large(text: str) -> TimeSpecError:

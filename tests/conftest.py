@@ -1,14 +1,14 @@
-"""Shared test helpers: compile text, run the CLI in-process, write files, find the examples."""
+"""Fixtures and hooks for every test; what tests import lives in tests/helpers/."""
 from __future__ import annotations
 
+import os
 import signal
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
-from mercmac.compiler import compile_source
-from mercmac.source import Source
+from helpers import budgets
+from helpers.paths import EXAMPLES
 
 # A suite started as a background job (`pytest &`) or by some CI runners inherits SIGINT as
 # ignored, and so would every process it starts: the Ctrl-C tests could not interrupt the
@@ -17,46 +17,34 @@ from mercmac.source import Source
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 
-ROOT = Path(__file__).resolve().parent.parent
-EXAMPLES = ROOT / "examples" / "macros"
+# Half of the suite's time is spent waiting on timeouts (a silent controller, a process that
+# must not answer), not computing, so more workers than cores pay: on 2 cores the pty and
+# property tests took 152 s in one process, 92 s in 2 workers, 84 s in 4 and 62 s in 6, but 6
+# made the paced emulator's 20 ms character timing miss. Two per core (README, Development).
+WORKERS_PER_CORE = 2
+# A run of one or two named files (`pytest tests/fmt/test_fmt.py -x`) stays in this process:
+# starting workers would cost more than they save, and pdb works.
+SERIAL_FILES = 2
 
 
-def compile_text(text: str, target: str | None = None):
-    """Compile a snippet as file 'test.mcm'."""
-    return compile_source(Source("test.mcm", text), target)
+def pytest_configure(config):
+    """The Hypothesis profile, before any test module builds its `@settings`."""
+    try:
+        budgets.load()
+    except ValueError as error:
+        raise pytest.UsageError(str(error)) from None
 
 
-def rules(text: str, target: str | None = None) -> list[str]:
-    """The rule names a snippet triggers, in report order."""
-    return [d.rule.name for d in compile_text(text, target).report.sorted()]
-
-
-def program_of(text: str, target: str | None = None):
-    """The lowered program of a snippet that must compile without errors."""
-    result = compile_text(text, target)
-    assert result.program is not None and not result.report.has_errors, \
-        [d.message for d in result.report.items]
-    return result.program
-
-
-def cli(*args, catch: bool = False, **kw):
-    """Run `mercmac ARGS...` in-process through the real click group; with `catch`, an
-    exception is kept in the result (so a traceback shows as one) instead of raised."""
-    from mercmac.cli import main
-
-    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=catch, **kw)
-
-
-def sim(*args):
-    """`mercmac sim ARGS...` in-process; an exception is kept in the result."""
-    return cli("sim", *args, catch=True)
-
-
-def leftovers(folder: Path) -> list[Path]:
-    """The temporary files an interrupted whole-or-nothing write would leave in `folder`."""
-    from mercmac import outfile
-
-    return sorted(folder.glob(f"{outfile.TEMP_PREFIX}*{outfile.TEMP_SUFFIX}"))
+@pytest.hookimpl(optionalhook=True)  # known only while pytest-xdist is loaded
+def pytest_xdist_auto_num_workers(config):
+    """`-n auto` (pyproject's addopts): PYTEST_XDIST_AUTO_NUM_WORKERS if set; none for a run
+    of a file or two; else two workers per core."""
+    if os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS"):
+        return None  # xdist's own hook reads it
+    files = {arg.split("::")[0] for arg in config.args}
+    if len(files) <= SERIAL_FILES and all(f.endswith(".py") for f in files):
+        return 0
+    return WORKERS_PER_CORE * (os.cpu_count() or 1)
 
 
 @pytest.fixture
@@ -85,19 +73,16 @@ def examples_dir() -> Path:
     return EXAMPLES
 
 
+@pytest.fixture
+def data_dir(tmp_path, monkeypatch) -> Path:
+    """mercmac's data folder (backups, flash history) as MERCMAC_DATA_DIR: tmp_path/data."""
+    folder = tmp_path / "data"
+    monkeypatch.setenv("MERCMAC_DATA_DIR", str(folder))
+    return folder
+
+
 @pytest.fixture(autouse=True)
 def _private_data_dir(tmp_path_factory, monkeypatch):
     """Backups and flash history go to a fresh folder, never the user's data directory."""
     monkeypatch.delenv("MERCMAC_DATA_DIR", raising=False)
     monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path_factory.mktemp("xdg-data")))
-
-
-def observed(record) -> dict:
-    """What a simulation run recorded, as plain data to compare two runs (fast-forward on/off)."""
-    return {
-        "reports": [(r.t, r.text) for r in record.reports],
-        "outputs": [(o.t, o.pattern) for o in record.outputs],
-        "dropped": (record.dropped["reports"], record.dropped["outputs"]),
-        "hazards": [(h.t, h.rule, h.where) for h in record.hazards],
-        "ended": record.ended_at,
-    }

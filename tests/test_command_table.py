@@ -10,10 +10,9 @@ import ast
 
 import pytest
 
-from conftest import ROOT
+from helpers.paths import PACKAGE, ROOT, TESTS
 from mercmac.commands import COMMANDS, MODELS, Arg, Command, Kind, Mnemonic
 
-PACKAGE = ROOT / "mercmac"
 # The table itself, and the parser lark generates from grammar.lark.
 EXEMPT = {"commands.py", "parser_tables.py"}
 # (module, mnemonic) -> why the literal must stay. Empty: keep it so.
@@ -70,7 +69,7 @@ def test_every_command_has_its_constant_and_no_more():
     assert Mnemonic.EM == "EM" and Mnemonic.FA_Q == "FA?" and type(Mnemonic.EM) is str
 
 
-SOURCES = sorted(PACKAGE.rglob("*.py")) + sorted((ROOT / "tests").glob("*.py"))
+SOURCES = sorted(PACKAGE.rglob("*.py")) + sorted(TESTS.rglob("*.py"))
 
 
 @pytest.mark.parametrize("path", SOURCES, ids=lambda p: str(p.relative_to(ROOT)))

@@ -10,7 +10,8 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from conftest import cli
+from helpers.budgets import budget
+from helpers.cli import cli
 from mercmac import config
 
 NAMES = ["mercmac.toml", "pyproject.toml"]
@@ -70,7 +71,7 @@ def folder(tmp_path_factory) -> Path:
     return path
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=budget(300), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(name=st.sampled_from(NAMES), data=DOCUMENTS)
 @example(name="pyproject.toml", data=b'tool = "x"\nnote = """\n[tool.mercmac]\n"""\n')
 @example(name="mercmac.toml", data=b"a = " + b"[" * 5000 + b"]" * 5000 + b"\n")

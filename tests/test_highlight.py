@@ -9,12 +9,14 @@ from hypothesis import strategies as st
 from pygments.lexers import get_lexer_by_name, get_lexer_for_filename
 from pygments.token import Comment, Error, Keyword, Name, Number, Operator
 
-from conftest import EXAMPLES, cli
+from helpers.budgets import budget
+from helpers.cli import cli
+from helpers.paths import EXAMPLE3, EXAMPLE_FILES
 from mercmac.commands import COMMANDS
 from mercmac.compiler import compile_file
 from mercmac.highlight import McmLexer
 
-FILES = sorted(EXAMPLES.glob("*.mcm"))
+FILES = EXAMPLE_FILES
 # The rules a word the lexer cannot read stands behind.
 UNREADABLE = {"syntax", "unknown-command"}
 
@@ -44,7 +46,7 @@ def test_errors_only_where_check_finds_an_unreadable_word(path):
     assert (errors == []) == is_clean(path), errors
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=budget(200), deadline=None)
 @given(st.text(alphabet=st.sampled_from(list("[]MCmc05+- \t\r\n,/{}@=?_.xXEWSabdeglnortwé")), max_size=60))
 def test_any_text_round_trips(text):
     assert "".join(v for _, v in tokens(text)) == text
@@ -104,7 +106,7 @@ def test_pygments_finds_the_lexer_through_its_entry_point():
 # -- mercmac's own diagnostics on a terminal ------------------------------------------------
 
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
-EX3 = EXAMPLES / "manual-example3-operator-moves.mcm"
+EX3 = EXAMPLE3
 
 
 def test_check_highlights_the_source_line_on_a_colour_terminal():

@@ -15,13 +15,13 @@ import termios
 
 import pytest
 
-from conftest import cli, leftovers
+from helpers.cli import cli
+from helpers.files import leftovers
 from mercmac import outfile
-from test_upload_emulator import serve
+from helpers.emulator import FAST, serve
 
 PROGRAM = "target C-863\n[MC00] EM5\n[MC05] MR5000,WS100\n"
 BUILT = "MD5,MR5000,WS100\nMD0,EM5\n"
-FAST = ["--timeout", "0.3"]
 ROOT = os.geteuid() == 0 if hasattr(os, "geteuid") else False
 EIO = OSError(errno.EIO, os.strerror(errno.EIO))
 

@@ -13,12 +13,15 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import mercmac
-from conftest import EXAMPLES, cli, compile_text
+from helpers.budgets import budget
+from helpers.cli import cli
+from helpers.compiling import compile_text
+from helpers.paths import EXAMPLE_FILES
 from mercmac.fmt import FormatError, format_text, load
 from mercmac.highlight import McmLexer
-from test_properties import programs
+from helpers.programs import programs
 
-EXAMPLE_TEXTS = [load(p.read_bytes())[0] for p in sorted(EXAMPLES.glob("*.mcm"))]
+EXAMPLE_TEXTS = [load(p.read_bytes())[0] for p in EXAMPLE_FILES]
 # The file: the `//` comment ran to the next LF and hid the rest of the file.
 CR_ONLY = b"macro a @20 { MR 5 }   // c\rautostart { call a }\r[MC05] MR 9\r"
 # Where the mercmac under test lives: a child process started there imports the same one.
@@ -64,7 +67,8 @@ def files(draw):
     return "\n".join(lines)
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@pytest.mark.slow
+@settings(max_examples=budget(150), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(files(), st.data())
 def test_any_mix_of_line_ends_builds_the_same_and_reports_the_same_places(text, data):
     mixed = with_ends(text, data)

@@ -9,7 +9,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import compile_text
+from helpers.budgets import budget
+from helpers.compiling import compile_text
 from mercmac import mdtext
 from mercmac.commands import C663, C863, COMMANDS, Arg
 from mercmac.emulator.virtual import VirtualController
@@ -90,7 +91,7 @@ LINES = st.lists(st.sampled_from(["MR5000", "WS", "WS100", "EM9", "XN1", "CP15",
                                   "MA-1073741823", "RP", "DI", "SV80000"]), min_size=1, max_size=16)
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=budget(50), deadline=None)
 @given(LINES)
 def test_parse_format_parse_is_a_round_trip(commands):
     line = ",".join(commands)
@@ -167,7 +168,7 @@ def lines(draw) -> tuple[str, int, str]:
     return line, draw(st.sampled_from([0, 5])), draw(st.sampled_from([C663, C863]))
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=budget(300), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(lines())
 def test_the_emulator_and_check_accept_and_refuse_the_same_lines(case):
     line, slot, model = case

@@ -8,13 +8,14 @@ from pathlib import Path
 
 import pytest
 
-from conftest import ROOT, cli, program_of
+from helpers.cli import cli
+from helpers.compiling import program_of
+from helpers.paths import PACKAGE, ROOT
 from mercmac import diagnostics
 from mercmac.sim.simulate import simulate
 from mercmac.vm import hazards
 from mercmac.vm.models import Options
 
-PACKAGE = ROOT / "mercmac"
 ALL = diagnostics.RULES + hazards.RULES
 LIMITS = (-20_000, 20_000)
 

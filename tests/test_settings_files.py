@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import cli
+from helpers.cli import cli
 from mercmac import config
 
 WARNS = "[MC00] EM5,WS\n"  # undefined-macro (MM012, warning) and default-argument (info)

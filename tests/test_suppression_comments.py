@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from conftest import cli
+from helpers.cli import cli
 
 # nested-call (a warning) on line 2, and nothing else: the comment goes on line 2.
 NESTED = "[MC00] EM1\n[MC01] EM2,MR5 {comment}\n[MC02] EM3\n[MC03] MR1\n"

@@ -96,29 +96,41 @@ FORMATS = ["text", "json", "github", "sarif", "concise"]
                    "200 in text and concise (a closing line counts the rest), 10000 in the "
                    "others (JSON then "
                    'adds "truncated": {FILE: count left out}). The summary counts them all.')
+@click.option("--fix", is_flag=True,
+              help="Apply the safe fixes (misspelled names, commands and keywords; a missing "
+                   "`target` when --target or the settings name the model), then report what "
+                   "remains.")
+@click.option("--diff", is_flag=True,
+              help="Print the fixes as a unified diff and write nothing; exit 1 if a file "
+                   "would change.")
 def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[str, ...],
           ignore: tuple[str, ...], statistics: bool, warnings_as_errors: bool,
-          limit: int | None) -> None:
+          limit: int | None, fix: bool, diff: bool) -> None:
     """Check .mcm files, or every .mcm file below a folder, against the firmware's rules.
 
     Settings (target, select, ignore) come from `[tool.mercmac]` in pyproject.toml or
     from mercmac.toml, found upward from each file; options override them.
     `// mercmac: ignore[RULE, ...]` on a line turns those rules off there.
 
+    --fix rewrites each file with its safe fixes, whole or not at all (its encoding,
+    byte-order mark and line ends kept), says on standard error which fixes it made in
+    which file, and reports the problems that remain.
+
     Exit 0 when no errors are found, 1 when there are errors (or warnings, with
-    --warnings-as-errors), 2 when a file cannot be read or an option or setting is wrong.
+    --warnings-as-errors), 2 when a file cannot be read (or fixed) or an option or
+    setting is wrong.
     """
     def work() -> int:
         from mercmac.compiler import checking
         from mercmac.diagnostics import Severity
-        from mercmac.source import read_source
 
         chosen = checking.options(target, select or None, ignore or None)
+        fixes = _fixes(files, fix, diff)
         paths, unreadable = _expand(files)
         results, found = [], []
         for f in paths:
             try:
-                source = read_source(f)
+                findings = _check_file(f, chosen, fixes)
             except OSError as e:
                 from mercmac.outfile import reason
                 from mercmac.render.report import printable
@@ -126,13 +138,19 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
                 say(f"cannot read {printable(f)}: {reason(e)}")
                 unreadable += 1
                 continue
-            findings = checking.check(source, _choice_for(f, chosen))
             results.append(findings.compilation)
             found += findings.diagnostics
         if not results:
             return EXIT_USAGE
-        _show(found, results, fmt, statistics, limit)
-        if unreadable:
+        if fixes is not None:
+            fixes.summary()
+        if diff:  # the diff is the output
+            return EXIT_USAGE if unreadable else fixes.diff_exit_code()
+        from mercmac.compiler.parse import paused_gc
+
+        with paused_gc():  # each collection would rescan every diagnostic (1 MB: 250,000)
+            _show(found, results, fmt, statistics, limit)
+        if unreadable or (fixes is not None and fixes.refused):
             return EXIT_USAGE
         failing = {Severity.ERROR, Severity.WARNING} if warnings_as_errors else {Severity.ERROR}
         return EXIT_FAILED if any(d.severity in failing for d in found) else EXIT_OK
@@ -154,16 +172,31 @@ def _expand(arguments: tuple[str, ...]) -> tuple[list[str], int]:
     return named.files, len(named.skipped) + len(named.empty)
 
 
-def _choice_for(path: str, chosen):
-    """The rules and model for a file: its settings under the options (mercmac.compiler.checking)."""
+def _fixes(files: tuple[str, ...], fix: bool, diff: bool):
+    """The fixing of this run (mercmac.cli.fixes), or None when it only checks."""
+    if not (fix or diff):
+        return None
+    if "-" in files and not diff:
+        from mercmac.cli.common import UsageError
+
+        raise UsageError("--fix writes the fixed files back, and standard input is no file",
+                         hint="use --diff to see its fixes")
+    from mercmac.cli.fixes import Fixes
+
+    return Fixes(diff)
+
+
+def _check_file(path: str, chosen, fixes=None):
+    """What `check` reports on one file: the language server's check (mercmac.compiler.checking),
+    after the file is fixed when `fixes` (--fix, --diff)."""
     from mercmac.compiler import checking
-    from mercmac.errors import UsageError
+    from mercmac.errors import SettingsError
     from mercmac.render.report import printable
 
     try:
-        return checking.choice_for(path, chosen)
-    except UsageError as e:  # it names a settings file, whose path may hold any character
-        raise UsageError(printable(e.message), hint=e.hint) from None
+        return fixes.file(path, chosen) if fixes is not None else checking.check_file(path, chosen)
+    except SettingsError as e:  # it names a settings file, whose path may hold any character
+        raise SettingsError(printable(e.message), hint=e.hint) from None
 
 
 def _show(found, results, fmt: str, statistics: bool, limit: int | None) -> None:

@@ -1,4 +1,5 @@
-"""What every command shares: option types and the one exception-to-exit-code place."""
+"""What every command shares: option types, the command line's own UsageError, and the one
+place that turns the library's errors (mercmac.errors) into a message and an exit code."""
 from __future__ import annotations
 
 import math
@@ -10,9 +11,14 @@ from typing import Callable
 import click
 
 from mercmac.commands import MODELS
-from mercmac.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE, MercmacError
+from mercmac.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE, InputError, MercmacError
 
 MODEL_CHOICE = click.Choice(MODELS, case_sensitive=False)
+
+
+class UsageError(InputError):
+    """Options that do not go together, or a value the command line cannot take (exit 2);
+    the library's own errors (mercmac.errors) are worded where they arise."""
 
 
 class FiniteFloat(click.ParamType):

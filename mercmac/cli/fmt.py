@@ -44,7 +44,7 @@ def _one(path: str, *, check: bool, diff: bool) -> bool | None:
         text, encoding = load(data)
         formatted = format_text(text)
         if diff and formatted != text:
-            _show_diff(text, formatted, name)
+            show_diff(text, formatted, name)
         elif path == "-" and not check:
             click.echo(encoding.write(formatted), nl=False)  # bytes: as they came in
         elif check and formatted != text:
@@ -63,7 +63,8 @@ def _one(path: str, *, check: bool, diff: bool) -> bool | None:
     return None
 
 
-def _show_diff(text: str, formatted: str, name: str) -> None:
+def show_diff(text: str, formatted: str, name: str) -> None:
+    """A unified diff of a file's text before and after (`fmt --diff`, `check --diff`)."""
     from mercmac.source import split_lines
 
     click.echo("".join(difflib.unified_diff(split_lines(text, keepends=True),

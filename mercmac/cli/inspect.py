@@ -12,10 +12,10 @@ from dataclasses import dataclass, field, replace
 
 import click
 
-from mercmac.cli.common import run_guarded
+from mercmac.cli.common import UsageError, run_guarded
 from mercmac.cli.upload import (_ADDRESS, _BAUD, _TIMEOUT, _timing, file_name, history_records,
                                 one_port, recalled)
-from mercmac.errors import EXIT_FAILED, EXIT_OK, UsageError
+from mercmac.errors import EXIT_FAILED, EXIT_OK
 
 _SOURCE = [
     click.argument("file", required=False, type=click.Path(dir_okay=False, allow_dash=True)),
@@ -55,10 +55,9 @@ def _read(file: str | None, port: str | None, address: int, baud: int, timeout: 
                          hint="FILE is a .mcm file, such as one `mercmac pull` wrote")
     if file is not None:
         return _read_file(file)
-    from mercmac.upload import connect, survey
+    from mercmac.upload import survey
 
-    with connect.open_controller(port, address, baud=baud, timing=_timing(timeout)) as c:
-        pulled = survey.pull(c)
+    pulled = survey.pull_file(port, address=address, baud=baud, timing=_timing(timeout))
     return Macros(pulled.macros, pulled.identity.version.model, f"{port}, address {address}",
                   port, address)
 

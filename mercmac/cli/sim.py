@@ -62,7 +62,7 @@ def sim(file, buttons, until, fmt, verbose, trace, vcd, vcd_limit, plot, interac
     its diagnostics are shown and the exit code is 1.
     """
     def work() -> int:
-        from mercmac.sim import run
+        from mercmac.cli import run
 
         request = run.Request(
             file=file, buttons=buttons, until=until, fmt=fmt, trace=trace, vcd=vcd,

@@ -6,15 +6,17 @@ bodies so that `mercmac check` starts fast.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import click
 
-from mercmac.cli.common import MODEL_CHOICE, FiniteFloat, run_guarded
-from mercmac.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, UsageError
+from mercmac.cli.common import MODEL_CHOICE, FiniteFloat, UsageError, run_guarded
+from mercmac.emulator.faults import EmptySlot, Framing  # two enums: light to import
+from mercmac.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
 
 _ADDRESS = click.option("--address", type=click.IntRange(0, 15), default=0, show_default=True,
                         help="Controller address, DIP switches 1-4 (MS176E §3.1.3).")
-# flash and pull: no --address looks for the controller (survey.find_address)
+# flash and pull: no --address looks for the controller (survey.reach)
 _FIND_ADDRESS = click.option("--address", type=click.IntRange(0, 15), default=None,
                              help="Controller address, DIP switches 1-4 (MS176E §3.1.3). "
                                   "Default: 0 if a controller answers there, else the only "
@@ -45,11 +47,49 @@ _TIMEOUT = click.option("--timeout", type=FiniteFloat(0.05, 60), default=1.0,
                         show_default=True, help="Seconds to wait for each reply.")
 
 
+def looks_like_program(text: str) -> bool:
+    """A `.mcm` name, or an existing regular file: not a port (devices are not regular files)."""
+    if text.lower().endswith(".mcm"):
+        return True
+    try:
+        return Path(text).is_file()
+    except (OSError, ValueError):
+        return False
+
+
+def split_flash_args(first: str | None, second: str | None, option: str | None,
+                     command: str = "flash") -> tuple[str | None, str]:
+    """(PORT or None, FILE) from `flash [PORT] FILE` (also `flash FILE PORT`); refuses a swapped pair or a missing FILE."""
+    if second is None:
+        if first is None:
+            raise UsageError("no program file given",
+                             hint=f"mercmac {command} [PORT] FILE.mcm")
+        return None, first  # one argument: the file; the port comes from -p, the environment or a search
+    if looks_like_program(first) and not looks_like_program(second):
+        raise UsageError(f"{first!r} is a program file where the port goes: the arguments are swapped",
+                         hint=f"mercmac {command} {second} {first}  (PORT first, then FILE)")
+    if option is not None and option != first:
+        raise UsageError(f"two ports given: {first!r} and -p/--port {option!r}",
+                         hint=f"give the port once: mercmac {command} {first} {second}")
+    return first, second
+
+
+def check_port_arg(port: str | None, option: str | None, command: str) -> str | None:
+    """The PORT of `pull`/`scan [PORT]`; a program file there, or two ports, is refused."""
+    if port is not None and looks_like_program(port):
+        raise UsageError(f"{port!r} is a program file where the port goes",
+                         hint=f"mercmac {command} PORT (`mercmac ports` lists them)")
+    if port is not None and option is not None and option != port:
+        raise UsageError(f"two ports given: {port!r} and -p/--port {option!r}",
+                         hint=f"give the port once: mercmac {command} {port}")
+    return port if port is not None else option
+
+
 def _port(port: str | None, option: str | None, command: str) -> str:
     """The port to open (mercmac.upload.ports); says on stderr how it was found if not given."""
     from mercmac.upload import ports as chooser
 
-    chosen = chooser.resolve(chooser.check_port_arg(port, option, command))
+    chosen = chooser.resolve(check_port_arg(port, option, command))
     if chosen.how:
         click.echo(f"port: {chosen.port} ({chosen.how})", err=True)
     return chosen.port
@@ -87,15 +127,12 @@ def flash(port, file, port_option, address, baud, dry_run, backup, erase_unused,
     """
     def work() -> int:
         nonlocal port, file
-        from pathlib import Path
-
         from mercmac.render import upload as view
         from mercmac.render.console import write_lines
         from mercmac.upload import backup as backups
         from mercmac.upload import flasher
-        from mercmac.upload import ports as chooser
 
-        given, file = chooser.split_flash_args(port, file, port_option)  # also `flash FILE PORT`
+        given, file = split_flash_args(port, file, port_option)
         port = _port(given, port_option, "flash")
         options = flasher.FlashOptions(erase_unused, dry_run, reset, Path(backup) if backup else None)
         try:
@@ -148,8 +185,7 @@ def _watch(port: str, address: int | None, finished: list):
 
         @contextmanager
         def searching(self):
-            with view.AddressProgress(sys.stderr, "no --address: looking for the controller") \
-                    as shown:
+            with _searching() as shown:
                 def probing(n: int) -> None:
                     searched[0] = True
                     shown(n)
@@ -190,22 +226,16 @@ def pull(port, port_option, output, address, baud, timeout, raw) -> None:
     """
     def work() -> int:
         nonlocal port, address
-        from pathlib import Path
-
         from mercmac.render import upload as view
         from mercmac.render.console import write_lines
-        from mercmac.upload import backup, connect, survey
+        from mercmac.upload import backup, survey
 
         port = _port(port, port_option, "pull")
         to_file = output and output != "-"
         if to_file:
             _check_output(Path(output))  # refused before reading, which stops a running macro
-        with connect.open_controller(port, address or 0, baud=baud, timing=_timing(timeout)) as c:
-            if address is None:  # 0 if anything answers there, else the only one that does
-                with view.AddressProgress(sys.stderr, "no --address: looking for the controller") \
-                        as shown:
-                    c.address = survey.find_address(c.transport, shown)
-            pulled = survey.pull(c)
+        pulled = survey.pull_file(port, address=address, baud=baud, timing=_timing(timeout),
+                                  searching=_searching)
         address = pulled.identity.address
         text, found = pulled.text, None
         if not raw:  # a program mercmac flashed comes back as its source (upload.history)
@@ -229,6 +259,13 @@ def pull(port, port_option, output, address, baud, timeout, raw) -> None:
         return EXIT_OK
 
     run_guarded(work)
+
+
+def _searching():
+    """No --address: the address probed, while looking for the controller (survey.reach)."""
+    from mercmac.render import upload as view
+
+    return view.AddressProgress(sys.stderr, "no --address: looking for the controller")
 
 
 def history_records() -> list:
@@ -324,9 +361,11 @@ def scan(port, port_option, baud, timeout, stop) -> None:
               help="Keep the macros (flash memory) in this file across runs.")
 @click.option("--firmware", default="2.30", show_default=True,
               help="Firmware version VE reports; 1.xx drops lines typed slower than 20 ms a character.")
-@click.option("--tm-framing", type=click.Choice(["etx-per-line", "one-etx"]), default="etx-per-line",
+@click.option("--tm-framing", type=click.Choice([f.value for f in Framing]),
+              default=Framing.ETX_PER_LINE.value,
               show_default=True, help="How a TM listing ends its lines (real controllers may do either).")
-@click.option("--empty-slot", type=click.Choice(["empty", "bare"]), default="empty",
+@click.option("--empty-slot", type=click.Choice([e.value for e in EmptySlot]),
+              default=EmptySlot.EMPTY.value,
               show_default=True, help="TMn of an empty slot: an empty report or a bare MCnnn.")
 @click.option("--log", "log_file", type=click.Path(dir_okay=False),
               help="Add every byte both ways to this file, timestamped, as it passes.")
@@ -343,7 +382,6 @@ def emulate(target, address, state, firmware, tm_framing, empty_slot, log_file, 
     """
     def work() -> int:
         from contextlib import nullcontext
-        from pathlib import Path
 
         from mercmac.emulator.virtual import Faults, VirtualController
         from mercmac.emulator.ptyserver import PtyServer

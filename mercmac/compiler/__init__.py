@@ -7,7 +7,8 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
-from mercmac.compiler.program import Macro, Op, Program
+from mercmac.compiler.program import Macro, Program
+from mercmac.ops import Op
 from mercmac.diagnostics import Report
 from mercmac.source import Source, read_source
 
@@ -76,13 +77,13 @@ def _check_partial(source: Source, module, broken: frozenset[int], report: Repor
 
 
 def compile_file(path: str, target: str | None = None) -> Compilation:
-    """Read and compile a file; an unreadable one is a UsageError (exit 2), worded as
+    """Read and compile a file; an unreadable one is an InputError (exit 2), worded as
     `check` words it: "cannot read FILE: reason"."""
-    from mercmac.errors import UsageError
+    from mercmac.errors import InputError
     from mercmac.outfile import reason
 
     try:
         source = read_source(path)
     except OSError as e:
-        raise UsageError(f"cannot read {path}: {reason(e)}") from None
+        raise InputError(f"cannot read {path}: {reason(e)}") from None
     return compile_source(source, target)

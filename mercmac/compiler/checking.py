@@ -15,7 +15,7 @@ from typing import Callable, Iterable, NamedTuple
 from mercmac import config, suppress
 from mercmac.compiler import Compilation
 from mercmac.diagnostics import Diagnostic, Report
-from mercmac.source import Source, Span
+from mercmac.source import Source, Span, read_source
 
 
 class Options(NamedTuple):
@@ -43,7 +43,7 @@ class Findings(NamedTuple):
 def options(target: str | None = None, select: Iterable[str] | None = None,
             ignore: Iterable[str] | None = None,
             names: tuple[str, str] = ("--select", "--ignore")) -> Options:
-    """Options from rules named by codes or names; a UsageError names the option (`names`)."""
+    """Options from rules named by codes or names; a SettingsError names the option (`names`)."""
     return Options(target.upper() if target else None,
                    None if select is None else suppress.selection(select, names[0]),
                    None if ignore is None else suppress.rule_set(ignore, names[1]))
@@ -60,6 +60,13 @@ def choice_for(path: str | None, chosen: Options = Options()) -> Choice:
     if ignore is None:
         ignore = suppress.rule_set(settings.ignore or (), f"ignore {where}")
     return Choice(suppress.chosen(select, ignore), chosen.target or settings.target)
+
+
+def check_file(path: str, chosen: Options = Options()) -> Findings:
+    """What `check` reports on the file at PATH ('-': standard input) under its settings and
+    `chosen`; OSError when it cannot be read."""
+    source = read_source(path)
+    return check(source, choice_for(path, chosen))
 
 
 def check(source: Source, choice: Choice,

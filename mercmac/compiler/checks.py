@@ -11,8 +11,9 @@ from mercmac import mdtext
 from mercmac.commands import MODELS, Arg, lookup
 from mercmac.compiler import ast
 from mercmac.compiler.parse import BROKEN, nearest_keyword
-from mercmac.compiler.program import MAX_RP, MAX_WA, MAX_WAITS, SLOTS, Op, rp_counts
-from mercmac.diagnostics import Report
+from mercmac.compiler.program import MAX_RP, MAX_WA, MAX_WAITS, SLOTS, rp_counts
+from mercmac.ops import Op
+from mercmac.diagnostics import Fix, Report
 from mercmac.source import Span
 from mercmac.suggest import suggest
 
@@ -45,7 +46,7 @@ def check_module(module: ast.Module, report: Report, target: str | None,
     slots: dict[int, Span] = {}
     for item in module.items:
         if isinstance(item, ast.RawBlock):
-            _claim_slot(item.slot, item.span, f"MC{item.slot:02d}", slots, report)
+            _claim_slot(item.slot, item.span, mdtext.slot_name(item.slot), slots, report)
             for command in item.commands:
                 _command(command, env, report, raw=True)
         elif isinstance(item, ast.Autostart):
@@ -101,7 +102,7 @@ def _block(body: tuple, env: Env, report: Report) -> None:
         if isinstance(stmt, ast.Command):
             _command(stmt, env, report, raw=False)
         elif isinstance(stmt, (ast.Call, ast.Goto)):
-            _macro_name(stmt.name, stmt.span, env, report)
+            _macro_name(stmt, env, report)
             if isinstance(stmt, ast.Goto) and i != len(body) - 1:
                 report.add("goto-not-last", stmt.span)
         elif isinstance(stmt, ast.When):
@@ -148,20 +149,38 @@ def _first_goto(body: tuple):
     return None
 
 
-def _macro_name(name: str, span: Span, env: Env, report: Report) -> None:
+def _macro_name(stmt: ast.Call | ast.Goto, env: Env, report: Report) -> None:
+    name = stmt.name
     if name not in env.macros and name not in env.unsure:
-        hint = _suggest(name, env.macros)
-        report.add("undefined-name", span, "macro", name=name, hint=hint)
+        meant = _nearest(name, env.macros)
+        report.add("undefined-name", stmt.span, "macro", name=name, hint=_did_you_mean(meant),
+                   fix=_fix(name_span(stmt), meant))
 
 
-def _suggest(name: str, known) -> str:
-    """'did you mean' the defined name nearest to `name` (mercmac.suggest: at most a third
-    of the name in edits), else the first with the same first three letters."""
+def name_span(stmt: ast.Call | ast.Goto) -> Span:
+    """Where the macro name of a `call` or `goto` stands: it ends the statement."""
+    end = stmt.span.end_column
+    return Span(stmt.span.end_line, end - len(stmt.name), stmt.span.end_line, end)
+
+
+def _nearest(name: str, known) -> str | None:
+    """The defined name nearest to `name` (mercmac.suggest: at most a third of the name in
+    edits), else the first with the same first three letters; None when none is near."""
     close = suggest(name, known, limit=len(name) // 3)
     if close is None:
         low = name.lower()
         close = min((k for k in known if k.lower().startswith(low[:3])), default=None)
-    return f"; did you mean '{close}'?" if close else ""
+    return close or None
+
+
+def _did_you_mean(meant: str | None) -> str:
+    """What a message ends with for a word `meant` instead of the one written."""
+    return f"; did you mean '{meant}'?" if meant else ""
+
+
+def _fix(span: Span, meant: str | None) -> Fix | None:
+    """The word at `span` replaced by the one `meant`: safe, as the word is unknown."""
+    return Fix.replacing(span, meant) if meant else None
 
 
 def _bounded(value: ast.Value, env: Env, report: Report, allowed: range, what: str,
@@ -187,8 +206,9 @@ def _resolve(value: ast.Value, env: Env, report: Report) -> int | None:
         if value.name in env.macros:
             report.add("undefined-name", value.span, "const-is-macro", name=value.name)
         else:
+            meant = _nearest(value.name, env.consts)
             report.add("undefined-name", value.span, "const", name=value.name,
-                       hint=_suggest(value.name, env.consts))
+                       hint=_did_you_mean(meant), fix=_fix(value.span, meant))
         return None
     env.values[value] = env.consts[value.name]
     return env.consts[value.name]
@@ -209,31 +229,38 @@ def _command(cmd: ast.Command, env: Env, report: Report, *, raw: bool) -> None:
         value = value.value if isinstance(value, ast.Number) else mdtext.TooLong(0)
     checked = mdtext.validate(cmd.word, value, model=env.target)
     for f in checked.findings:
-        values = dict(f.values)
+        values, where, fix = dict(f.values), _where(cmd, f), None
         if f.rule == "unknown-command":
-            values["hint"] = _unknown_hint(cmd, values["hint"], raw)
-        report.add(f.rule, _where(cmd, f), f.variant, **values)
+            values["hint"], meant = _unknown_hint(cmd.word, _argument(cmd.value), type(cmd.value),
+                                                  raw, values["hint"], values["guess"])
+            fix = Fix.replacing(where, meant) if meant else None
+        report.add(f.rule, where, f.variant, fix=fix, **values)
     if checked.op is not None:
         env.ops[cmd] = checked.op._replace(span=cmd.span)
 
 
-def _unknown_hint(cmd: ast.Command, spelling: str, raw: bool) -> str:
-    """What an unknown command's message ends with: the hint of a natural guess (`LED 1`:
-    write `CN 1`; compiler/guesses.py), else a keyword misspelled (`cal scan`: a keyword,
-    not a command), else the nearest mnemonic by spelling (`spelling`, from mdtext)."""
-    guessed = _guessed(cmd.word, _argument(cmd.value), raw)
-    if guessed is not None:
-        return f"; {guessed}"
-    keyword = nearest_keyword(cmd.word) if not raw and cmd.value is not None else None
-    return f"; did you mean '{keyword}'?" if keyword is not None else spelling
-
-
 # A 1 MB line of unknown commands asks for the same few words 250,000 times (check_large).
 @functools.lru_cache(maxsize=1024)
-def _guessed(word: str, argument: str | None, raw: bool) -> str | None:
+def _unknown_hint(word: str, argument: str | None, kind: type, raw: bool, spelling: str,
+                  guess: str | None) -> tuple[str, str | None]:
+    """What an unknown command's message ends with, and the word meant when it is one:
+    the hint of a natural guess (`LED 1`: write `CN 1`; compiler/guesses.py; no word to
+    put in its place), else a keyword misspelled (`cal scan`: a keyword, not a command),
+    else the nearest mnemonic by spelling (mdtext's hint `spelling` and its `guess`).
+    `kind`: the type of the command's value (NoneType when it has none)."""
     from mercmac.compiler import guesses  # only once a command is unknown: `check` starts quick
 
-    return guesses.hint(word, argument, raw=raw)
+    guessed = guesses.hint(word, argument, raw=raw)
+    if guessed is not None:
+        return f"; {guessed}", None
+    keyword = nearest_keyword(word) if not raw and kind is not type(None) else None
+    if keyword is not None:  # only `call NAME` and `goto NAME` are whole without a block
+        return _did_you_mean(keyword), (keyword if keyword in _NAMING and kind is ast.Name
+                                         else None)
+    return spelling, guess
+
+
+_NAMING = ("call", "goto")  # the keywords a statement `KEYWORD NAME` starts with (SPEC §1)
 
 
 def _argument(value) -> str | None:
@@ -246,5 +273,7 @@ def _argument(value) -> str | None:
 def _where(cmd: ast.Command, f: mdtext.Finding) -> Span:
     if f.where == "word":
         s = cmd.word_span
-        return Span(s.line, s.column + f.skip, s.end_line, s.end_column)
+        # the word's own span unless the place meant is inside it: a span per unknown
+        # command of a 1 MB line is 250,000 spans (check_large)
+        return s if not f.skip else Span(s.line, s.column + f.skip, s.end_line, s.end_column)
     return cmd.value.span if f.where == "value" else cmd.span

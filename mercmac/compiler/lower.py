@@ -17,27 +17,30 @@
 """
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 from mercmac.commands import Mnemonic
 from mercmac.compiler import ast
 from mercmac.compiler.checks import Env
-from mercmac.compiler.program import (MAX_COMMANDS, SLOTS, Macro, Op, Origin, Program, Role,
-                                      rp_counts, wait_pieces)
+from mercmac.compiler.program import MAX_COMMANDS, SLOTS, Macro, Program, rp_counts, wait_pieces
 from mercmac.diagnostics import Report
+from mercmac.mdtext import slot_name
+from mercmac.ops import Op, Origin, Role
 from mercmac.source import Span
 
 
 class _Macro:
     """A macro being lowered: its EM targets may not have slots yet."""
 
-    __slots__ = ("name", "origin", "span", "slot", "ops", "root", "depth")
+    __slots__ = ("name", "origin", "span", "slot", "ops", "root", "depth", "too_long")
 
     def __init__(self, name: str, origin: Origin, span: Span, slot: int | None = None):
         self.name, self.origin, self.span, self.slot = name, origin, span, slot
         self.ops: list = []  # Op, or _Em before allocation
         self.root: _Macro | None = None  # of a helper: the user's macro it was made for
         self.depth = 0  # of a helper: how many owners it has, the root one included
+        self.too_long = False  # a loop line reported as too long to split (`split` fits again)
 
 
 class _Em(NamedTuple):
@@ -72,6 +75,34 @@ def _unchained(ops: list) -> list:
         whole += last.target.ops  # the tail EM stays: it is a call too
         last = whole[-1]
     return whole
+
+
+@dataclass(frozen=True, slots=True)
+class _Context:
+    """Where a statement sequence is lowered: whose line, and how that line may be laid out.
+    A block's statements are lowered in a context derived from their line's (`replace`)."""
+
+    owner: _Macro
+    at_start: bool = True  # the sequence starts the owner's line (RP jumps back there)
+    loop: bool = False  # a repeat/every body: it runs up to the loop's RP, then again
+    cont: _Macro | None = None  # when the line is done, it continues there by a tail EM
+    leaf: bool = False  # the line is called from a loop, so it must call nothing
+    # a loop that starts the line may stay on it: not in a loop with a TI, which would
+    # then read the inner loop's RP counter (MS176E §6.4 TI)
+    nest: bool = True
+
+    def rest(self, owner: _Macro) -> _Context:
+        """The line of what follows a block that took the return point."""
+        return replace(self, owner=owner, at_start=True, loop=False, nest=True)
+
+    def block(self, owner: _Macro, cont: _Macro | None) -> _Context:
+        """The line of a block hoisted from this one: a loop's or a leaf's must call nothing."""
+        return replace(self, owner=owner, at_start=False, loop=False, cont=cont,
+                       leaf=self.loop or self.leaf, nest=True)
+
+    def body(self, stmt) -> _Context:
+        """The line of a loop's body, which starts the line the loop's RP repeats."""
+        return replace(self, at_start=True, loop=True, cont=None, nest=not _has_ti(stmt.body))
 
 
 class _Todo:
@@ -115,6 +146,49 @@ class _Taker(NamedTuple):
     stmt: object
     block: _Macro
     after: _Macro
+    ctx: _Context  # the block's line
+
+
+class _Line:
+    """One line being lowered: its context, the statements left, its ops so far, and how
+    it ended (a goto, or a hoisted block that took its return point)."""
+
+    __slots__ = ("ctx", "todo", "ops", "started", "ended", "taker")
+
+    def __init__(self, ctx: _Context, todo: _Todo):
+        self.ctx, self.todo, self.ops = ctx, todo, []
+        self.started = not ctx.at_start  # the line began before (a when block's XN/XF)
+        self.ended, self.taker = False, None
+
+    @property
+    def first(self) -> bool:
+        """Whether the statement being lowered starts the owner's line."""
+        return not self.started and not self.ops
+
+    @property
+    def more(self) -> bool:
+        """Whether statements follow the one being lowered on this line."""
+        return bool(self.todo)
+
+    @property
+    def code_after(self) -> bool:
+        """Whether anything runs after the statement: more statements, a tail EM, a loop's RP."""
+        return self.more or self.ctx.cont is not None or self.ctx.loop
+
+    def splice(self, stmts: tuple) -> None:
+        self.todo.splice(stmts, self.ctx.owner.span)  # runs here, before what follows
+
+    def end(self, ops: list, taker: _Taker | None = None) -> None:
+        self.ops += ops
+        self.ended, self.taker = True, taker
+
+
+class _Added(Op):
+    """An op the compiler adds to a loop (RP, WA): a too-long loop counts them apart from
+    the commands the user wrote. Lowered ops are fresh objects, so the type is the mark
+    (an id() of an op, once dropped, could be another op's)."""
+
+    __slots__ = ()
 
 
 def _is_em(op) -> bool:
@@ -133,9 +207,9 @@ class _Lowerer:
         self.loops: list[_Macro] = []  # the macro of each loop being lowered (for TI)
         self.warned: set = set()
         self.inlined: set[str] = set()
-        self.added: set[int] = set()  # id() of the RPs and WAs a loop adds: the user did not write them
-        self.calling_blocks: set[tuple] = set()  # (id(stmt), leaf) of hoisted blocks that call on
-        self.too_long: set[_Macro] = set()  # loop lines reported as too long to split
+        # (span, leaf) of the hoisted blocks that call on: a statement is known by where it
+        # stands (an inlined or unrolled copy is the same statement, lowered the same)
+        self.calling_blocks: set[tuple] = set()
 
     def new(self, name: str, origin: Origin, span: Span, slot: int | None = None) -> _Macro:
         m = _Macro(name, origin, span, slot)
@@ -171,154 +245,175 @@ class _Lowerer:
         made.root, made.depth = root, owner.depth + 1
         return made
 
-    # -- statements --------------------------------------------------------
-    def seq(self, stmts: tuple, owner: _Macro, *, at_start: bool, loop: bool,
-            cont: _Macro | None = None, leaf: bool = False, nest: bool = True) -> list:
-        """The ops of a statement sequence that runs to the end of `owner`'s line
-        (inside a repeat/every body: up to the loop's RP), then tail-EMs `cont`.
-
-        `leaf`: the line is called from a loop and must call nothing, so small
-        repeats are unrolled. `nest`: a loop at the start of the line may stay in
-        it (false in a loop whose TI would then read an inner RP's counter).
+    # -- lines -------------------------------------------------------------
+    def seq(self, stmts: tuple, ctx: _Context) -> list:
+        """The ops of a statement sequence that runs to the end of its line (inside a
+        repeat/every body: up to the loop's RP), then tail-EMs `ctx.cont`.
 
         Where a hoisted block takes the return point, the rest of the line is a
         line of its own; the rests are lowered one after another (a chain of
         thousands recursed, issue 20), then each block with its rest as its tail,
         the last first: the order the macros were always made in.
         """
-        todo, takers = _Todo(stmts, owner.span), []
-        ops, taker = self.line(todo, owner, at_start=at_start, loop=loop, cont=cont, leaf=leaf,
-                               nest=nest)
+        todo, takers = _Todo(stmts, ctx.owner.span), []
+        ops, taker = self.line(todo, ctx)
         while taker is not None:
             takers.append(taker)
             if not todo:  # nothing followed the block: its tail is `cont`
                 break
             rest = taker.after
-            rest.ops, taker = self.line(todo, rest, at_start=True, loop=False, cont=cont, leaf=leaf)
-        for stmt, block, after in reversed(takers):
-            block.ops = self.block_ops(stmt, block, after, leaf)
+            rest.ops, taker = self.line(todo, ctx.rest(rest))
+        for taker in reversed(takers):
+            taker.block.ops = self.block_ops(taker.stmt, taker.ctx)
         return ops
 
-    def line(self, todo: _Todo, owner: _Macro, *, at_start: bool, loop: bool,
-             cont: _Macro | None, leaf: bool, nest: bool = True) -> tuple[list, _Taker | None]:
+    def line(self, todo: _Todo, ctx: _Context) -> tuple[list, _Taker | None]:
         """The ops of one line (see `seq`) and the hoisted block that took its return
         point, if one did: what is left in `todo` is then that block's rest."""
-        out: list = []
-        while todo:
-            stmt = todo.pop()
-            more, first = bool(todo), at_start and not out
-            if isinstance(stmt, ast.Goto):
-                target = self.named.get(stmt.name)  # a goto transfers for good: nothing after it runs
-                return out + ([] if target is None else [_Em(target, stmt.span, Role.GOTO)]), None
-            if isinstance(stmt, ast.Repeat) and self.count(stmt) == 0:
-                continue  # `repeat 0` runs nothing (reported as info)
-            body = self.spliced(stmt, more or cont is not None or loop, leaf and not first)
-            if body is not None:
-                todo.splice(body, owner.span)  # runs here, before what follows the statement
-            elif isinstance(stmt, ast.Command):
-                if stmt in self.env.ops:
-                    out.append(self.command(self.env.ops[stmt], owner))
-            elif isinstance(stmt, ast.Call):
-                target = self.named.get(stmt.name)
-                if target is not None:
-                    out.append(_Em(target, stmt.span, Role.CALL))
-            elif isinstance(stmt, ast.When) and not more and not loop and cont is None:
-                out += self.conditions(stmt)  # a block that ends the line stays on it
-                todo.splice(stmt.body, owner.span)
-                at_start = False
-            elif (isinstance(stmt, (ast.Repeat, ast.Every)) and first and nest
-                  and not (loop and _has_ti(stmt.body))):
-                # RP jumps to the start of the line: a loop that starts its line stays in
-                # it, and what follows runs on the same line once the loop is done.
-                out += self.loop_ops(stmt, owner, leaf)
-            else:
-                block, after = self.hoist(stmt, owner, todo, cont,
-                                          may_take=bool(more or cont) and not loop,
-                                          leaf=loop or leaf)
-                out.append(_Em(block, stmt.span, Role.HOIST))
-                if after is not None:
-                    return out + _tail(after, stmt.span), _Taker(stmt, block, after)
-        return out + _tail(cont, todo.last), None
+        line = _Line(ctx, todo)
+        while todo and not line.ended:
+            self.statement(todo.pop(), line)
+        if not line.ended:
+            line.ops += _tail(ctx.cont, todo.last)
+        return line.ops, line.taker
 
-    def spliced(self, stmt, code_after: bool, unroll: bool) -> tuple | None:
-        """The statements that run in place of `stmt` on its line, if any: the body of a
-        callee that calls on (a call with code after it would need a second return
-        point), of a loop that runs once, of a small repeat on a line that must call nothing."""
-        if isinstance(stmt, ast.Call):
-            return self.env.macros[stmt.name].body if code_after and self.inline(stmt) else None
-        if isinstance(stmt, (ast.Repeat, ast.Every)) and self.once(stmt):
-            return stmt.body
-        if isinstance(stmt, ast.Repeat) and unroll and self.unrollable(stmt):
-            return stmt.body * self.count(stmt)
-        return None
+    def statement(self, stmt, line: _Line) -> None:
+        match stmt:
+            case ast.Command():
+                self.command(stmt, line)
+            case ast.Call():
+                self.call(stmt, line)
+            case ast.Goto():
+                self.goto(stmt, line)
+            case ast.When():
+                self.when(stmt, line)
+            case ast.Repeat():
+                self.repeat(stmt, line)
+            case ast.Every():
+                self.every(stmt, line)
 
-    def hoist(self, stmt, owner: _Macro, todo: _Todo, cont: _Macro | None, *,
-              may_take: bool, leaf: bool) -> tuple[_Macro, _Macro | None]:
-        """Move a block into a macro of its own. If code follows it (`may_take`) and the
-        block calls on, it takes the return point: what follows continues in `after`, a
-        macro (or the line's `cont`) that both the block and the line reach by a tail EM,
-        and the block is lowered once that is (see `seq`)."""
-        block = self.helper(owner, type(stmt).__name__.lower(), stmt.span)
-        if not may_take:
-            block.ops = self.block_ops(stmt, block, None, leaf)
-        elif self.calls_on_alone(stmt, block, leaf):
-            return block, self.helper(owner, "rest", todo.peek().span) if todo else cont
-        return block, None
+    # -- statements, one kind each -------------------------------------------
+    def command(self, stmt: ast.Command, line: _Line) -> None:
+        """A native command; a TI moved away from the RP of its loop is reported."""
+        op, owner = self.env.ops.get(stmt), line.ctx.owner
+        if op is None:  # invalid: reported by the checks
+            return
+        if op.mnemonic == Mnemonic.TI and self.loops and self.loops[-1] is not owner \
+                and op.span not in self.warned:
+            self.warned.add(op.span)
+            self.report.add("ti-moved", op.span, owner=owner.name, loop=self.loops[-1].name)
+        line.ops.append(op)
 
-    def calls_on_alone(self, stmt, block: _Macro, leaf: bool) -> bool:
+    def call(self, stmt: ast.Call, line: _Line) -> None:
+        """An EM; the callee's body in its place where it calls on and code follows (a
+        second return point, MS176E §3.8.4)."""
+        if line.code_after and self.inline(stmt):
+            line.splice(self.env.macros[stmt.name].body)
+            return
+        target = self.named.get(stmt.name)
+        if target is not None:
+            line.ops.append(_Em(target, stmt.span, Role.CALL))
+
+    def goto(self, stmt: ast.Goto, line: _Line) -> None:
+        """A goto transfers for good: nothing after it runs, and its EM ends the line."""
+        target = self.named.get(stmt.name)
+        line.end([] if target is None else [_Em(target, stmt.span, Role.GOTO)])
+
+    def when(self, stmt: ast.When, line: _Line) -> None:
+        """XN/XF and the block; a block that ends the line stays on it, others are hoisted."""
+        ctx = line.ctx
+        if line.more or ctx.loop or ctx.cont is not None:
+            self.hoist(stmt, line)
+            return
+        line.ops += self.conditions(stmt)
+        line.splice(stmt.body)
+        line.started = True
+
+    def repeat(self, stmt: ast.Repeat, line: _Line) -> None:
+        """`repeat 0` runs nothing (reported as info); `repeat 1` (or a body that ends in a
+        goto) runs once in its place; a small one on a line that must call nothing is
+        written out; other counts loop."""
+        first = line.first
+        if self.count(stmt) == 0:
+            return
+        if self.once(stmt):
+            line.splice(stmt.body)
+        elif line.ctx.leaf and not first and self.unrollable(stmt):
+            line.splice(stmt.body * self.count(stmt))
+        else:
+            self.loop(stmt, line, first)
+
+    def every(self, stmt: ast.Every, line: _Line) -> None:
+        """A polling loop; one whose body ends in a goto runs once, in its place."""
+        if self.once(stmt):
+            line.splice(stmt.body)
+        else:
+            self.loop(stmt, line, line.first)
+
+    def loop(self, stmt, line: _Line, first: bool) -> None:
+        """RP jumps to the start of the line: a loop that starts its line stays in it, and
+        what follows runs on the same line once the loop is done; other loops are hoisted."""
+        ctx = line.ctx
+        if first and ctx.nest and not (ctx.loop and _has_ti(stmt.body)):
+            line.ops += self.loop_ops(stmt, ctx)
+        else:
+            self.hoist(stmt, line)
+
+    # -- blocks --------------------------------------------------------------
+    def hoist(self, stmt, line: _Line) -> None:
+        """Move a block into a macro of its own, called by an EM. If code follows it and
+        the block calls on, it takes the return point: what follows continues in a macro
+        (or the line's `cont`) that both the block and the line reach by a tail EM, and
+        the block is lowered once that is (see `seq`)."""
+        ctx = line.ctx
+        block = self.helper(ctx.owner, type(stmt).__name__.lower(), stmt.span)
+        line.ops.append(_Em(block, stmt.span, Role.HOIST))
+        alone = ctx.block(block, None)
+        if ctx.loop or not (line.more or ctx.cont is not None):  # nothing after: may call on
+            block.ops = self.block_ops(stmt, alone)
+        elif self.calls_on_alone(stmt, alone):
+            after = self.helper(ctx.owner, "rest", line.todo.peek().span) if line.more else ctx.cont
+            line.end(_tail(after, stmt.span), _Taker(stmt, block, after, ctx.block(block, after)))
+
+    def calls_on_alone(self, stmt, ctx: _Context) -> bool:
         """Whether a hoisted block, lowered alone, calls on. If not, that lowering is the
         block's; if so, it is dropped and the answer kept: a block in nested blocks that
         call on was asked again in each lowering of theirs, 2^depth times (issue 20)."""
-        key = (id(stmt), leaf)  # the AST outlives the lowering: ids stay unique
+        key = (stmt.span, ctx.leaf)
         if key in self.calling_blocks:
             return True
         mark = self.mark()
-        block.ops = self.block_ops(stmt, block, None, leaf)
-        if not _calls_on(block.ops):
+        ctx.owner.ops = self.block_ops(stmt, ctx)
+        if not _calls_on(ctx.owner.ops):
             return False
         self.forget(mark)
         self.calling_blocks.add(key)
         return True
 
-    def command(self, op: Op, owner: _Macro) -> Op:
-        """A native command; a TI moved away from the RP of its loop is reported."""
-        if op.mnemonic == Mnemonic.TI and self.loops and self.loops[-1] is not owner \
-                and op.span not in self.warned:
-            self.warned.add(op.span)
-            self.report.add("ti-moved", op.span, owner=owner.name, loop=self.loops[-1].name)
-        return op
-
-    def block_ops(self, stmt, block: _Macro, cont: _Macro | None, leaf: bool) -> list:
-        """A hoisted when/repeat/every block's ops, fitted, ending with a tail EM to `cont`."""
+    def block_ops(self, stmt, ctx: _Context) -> list:
+        """A hoisted when/repeat/every block's ops, fitted, ending with a tail EM to `ctx.cont`."""
+        block = ctx.owner
         if isinstance(stmt, ast.When):
-            block.ops = self.conditions(stmt) + self.seq(stmt.body, block, at_start=False,
-                                                         loop=False, cont=cont, leaf=leaf)
+            block.ops = self.conditions(stmt) + self.seq(stmt.body, ctx)
         else:
-            block.ops = self.loop_ops(stmt, block, leaf) + _tail(cont, stmt.span)
+            block.ops = self.loop_ops(stmt, ctx) + _tail(ctx.cont, stmt.span)
         self.fit(block)  # a block that is split calls on, like one that calls
         return block.ops
 
-    def loop_ops(self, stmt, owner: _Macro, leaf: bool) -> list:
-        """A loop that starts `owner`'s line: its body, then RP (every: WA, RP, RP)."""
-        self.loops.append(owner)
-        body = self.seq(stmt.body, owner, at_start=True, loop=True, leaf=leaf,
-                        nest=not _has_ti(stmt.body))
+    def loop_ops(self, stmt, ctx: _Context) -> list:
+        """A loop that starts `ctx.owner`'s line: its body, then RP (every: WA, RP, RP)."""
+        self.loops.append(ctx.owner)
+        body = self.seq(stmt.body, ctx.body(stmt))
         self.loops.pop()
         if isinstance(stmt, ast.Repeat):
             # RP n runs the line n+1 times; two RPs multiply (program.rp_counts)
-            return body + self.add([Op(Mnemonic.RP, n, stmt.span)
-                                    for n in rp_counts(self.count(stmt))])
+            return body + [_Added(Mnemonic.RP, n, stmt.span) for n in rp_counts(self.count(stmt))]
         # every T: wait T (several WAs past 65535 ms), then RP,RP = 65536 x 65536
         # passes, "forever" (§3.8.6 Example 1)
         period = self.value(stmt.period) or 0  # every 0ms: no WA0, a busy loop (every-zero)
-        waits = [Op(Mnemonic.WA, ms, stmt.span) for ms in wait_pieces(period)] if period else []
-        return body + self.add(waits + [Op(Mnemonic.RP, None, stmt.span),
-                                        Op(Mnemonic.RP, None, stmt.span)])
-
-    def add(self, ops: list) -> list:
-        """Ops the compiler adds to a loop (RP, WA): a too-long loop counts them apart."""
-        self.added.update(id(op) for op in ops)
-        return ops
+        waits = [_Added(Mnemonic.WA, ms, stmt.span) for ms in wait_pieces(period)] if period else []
+        return body + waits + [_Added(Mnemonic.RP, None, stmt.span),
+                               _Added(Mnemonic.RP, None, stmt.span)]
 
     def conditions(self, stmt: ast.When) -> list:
         return [Op(Mnemonic.XF if c.negated else Mnemonic.XN, self.value(c.value), c.span)
@@ -359,15 +454,15 @@ class _Lowerer:
                 self.named[item.name] = self.new(item.name, Origin.MACRO, item.span, pin)
         for item in module.items:
             if isinstance(item, ast.RawBlock):
-                m = self.new(f"MC{item.slot:02d}", Origin.RAW, item.span, item.slot)
+                m = self.new(slot_name(item.slot), Origin.RAW, item.span, item.slot)
                 m.ops = [self.env.ops[c] for c in item.commands if c in self.env.ops]
             elif isinstance(item, ast.Autostart):
                 m = self.new("autostart", Origin.AUTOSTART, item.span, 0)
-                m.ops = self.seq(item.body, m, at_start=True, loop=False) or _nothing(item.span)
+                m.ops = self.seq(item.body, _Context(m)) or _nothing(item.span)
             elif isinstance(item, ast.MacroDef) and item.name in self.named:
                 m = self.named[item.name]
                 if self.env.macros[item.name] is item:
-                    m.ops = self.seq(item.body, m, at_start=True, loop=False) or _nothing(item.span)
+                    m.ops = self.seq(item.body, _Context(m)) or _nothing(item.span)
 
     def calling(self) -> set[str]:
         """The named macros whose lowered line calls on (contains an EM)."""
@@ -401,10 +496,10 @@ class _Lowerer:
     def too_long_loop(self, m: _Macro) -> None:
         """A loop line that cannot be split, said in the user's terms: the commands they
         wrote, and the RP (WA) the loop adds, which they did not."""
-        if m in self.too_long:
+        if m.too_long:
             return  # `split` fits every macro again
-        self.too_long.add(m)
-        added = [op for op in m.ops if id(op) in self.added or
+        m.too_long = True
+        added = [op for op in m.ops if isinstance(op, _Added) or
                  (isinstance(op, _Em) and op.role in (Role.HOIST, Role.CONTINUE))]
         loop = next((op.span for op in added if isinstance(op, Op)), m.span)
         self.report.add("too-many-commands", loop, "loop", count=len(m.ops) - len(added),
@@ -512,7 +607,7 @@ def _span_of(op, default: Span) -> Span:
 def _final(op) -> Op:
     if isinstance(op, _Em):
         return Op(Mnemonic.EM, op.target.slot, op.span, op.role)
-    return op
+    return Op(*op) if isinstance(op, _Added) else op
 
 
 def lower(module: ast.Module, env: Env, report: Report, file: str = "") -> Program:

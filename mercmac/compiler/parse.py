@@ -26,14 +26,13 @@ from typing import NamedTuple
 from mercmac import mdtext
 from mercmac.commands import Mnemonic, lookup
 from mercmac.compiler import parser_tables as lark
-from mercmac.diagnostics import Report
+from mercmac.diagnostics import Fix, Report
 from mercmac.source import Span, to_lf
 
 # `when`/`repeat`/`every` blocks nested deeper cannot fit the controller: each level needs
 # a macro or a condition of its own and there are 32 macros of 16 commands (MS176E §3.8).
 MAX_NESTING = 32
 _NESTED = ("when", "repeat", "every")
-_PARSER = None
 
 # Terminal names of grammar.lark as a person would call them.
 _TERMINALS = {
@@ -75,11 +74,53 @@ def paused_gc():
 
 
 def parser():
-    """The stand-alone LALR parser, built once per process."""
-    global _PARSER
-    if _PARSER is None:
-        _PARSER = lark.Lark_StandAlone(lexer_callbacks={"RAW_LINE": _raw_line})
-    return _PARSER
+    """The stand-alone LALR parser (lark's), built once per process."""
+    return _parser().lark
+
+
+@functools.cache
+def _parser() -> _Parser:
+    return _Parser()
+
+
+class _Parser:
+    """lark's parser of grammar.lark, and what a parse under way needs beside it: the recovery
+    that reports its errors, and where the named errors' examples fail (`_label`)."""
+
+    def __init__(self):
+        self.lark = lark.Lark_StandAlone(lexer_callbacks={"RAW_LINE": self._raw_line})
+        self.recovery: _Recovery | None = None  # of the parse under way
+        self.examples: dict[str, set] | None = None
+
+    def parse(self, text: str, recovery: _Recovery | None = None):
+        """lark's tree of TEXT; RECOVERY (None: raise at the first error) hears every error."""
+        outer, self.recovery = self.recovery, recovery  # an example is read amid a file
+        try:
+            return self.lark.parse(text, on_error=recovery)
+        finally:
+            self.recovery = outer
+
+    def _raw_line(self, token):
+        """Read a raw block's commands as the controller reads a stored line (mercmac.mdtext);
+        its syntax errors are the parser's (one per line, and the file is not checked further)."""
+        token.value = raw = _read_raw(str(token))
+        if raw.problems and self.recovery is not None:
+            self.recovery.raw_error(token, raw.problems[0])
+        return token
+
+    def example_keys(self) -> dict[str, set]:
+        """label -> the (state, token) keys where its examples fail, found once."""
+        if self.examples is None:
+            self.examples = {label: set(map(self._fails_at, examples))
+                             for label, examples in _EXAMPLES.items()}
+        return self.examples
+
+    def _fails_at(self, example: str):
+        try:
+            self.parse(example)  # no recovery: not the file's errors
+        except lark.UnexpectedInput as e:
+            return _key(e)
+        return None
 
 
 class NotParsed(ValueError):
@@ -251,24 +292,19 @@ class _Recognizer(NamedTuple):
     kept: frozenset  # terminals a tree keeps (not `_NL`, not keywords and punctuation)
 
 
-_RECOGNIZER: list[_Recognizer] = []
-
-
+@functools.cache
 def _recognizer() -> _Recognizer:
     """The automaton of the stand-alone parser, built once per process."""
-    if not _RECOGNIZER:
-        frontend = lark.Lark_StandAlone().parser
-        ignored = frozenset(frontend.lexer_conf.ignore)
-        parse_table = frontend.parser.parser.parse_table
-        table = {state: {kind: (True, arg) if action is lark.Shift else
-                         (False, (len(arg.expansion), arg.origin.name, _node(arg)))
-                         for kind, (action, arg) in actions.items()}
-                 for state, actions in parse_table.states.items()}
-        _RECOGNIZER.append(_Recognizer(
-            _Lexers(frontend.lexer.lexers), table,
-            parse_table.start_states["start"], parse_table.end_states["start"], ignored,
-            ignored - {"COMMENT"}, _kept(frontend.parser_conf.rules)))
-    return _RECOGNIZER[0]
+    frontend = lark.Lark_StandAlone().parser
+    ignored = frozenset(frontend.lexer_conf.ignore)
+    parse_table = frontend.parser.parser.parse_table
+    table = {state: {kind: (True, arg) if action is lark.Shift else
+                     (False, (len(arg.expansion), arg.origin.name, _node(arg)))
+                     for kind, (action, arg) in actions.items()}
+             for state, actions in parse_table.states.items()}
+    return _Recognizer(_Lexers(frontend.lexer.lexers), table, parse_table.start_states["start"],
+                       parse_table.end_states["start"], ignored, ignored - {"COMMENT"},
+                       _kept(frontend.parser_conf.rules))
 
 
 def _node(rule) -> str | None:
@@ -323,25 +359,12 @@ class RawLine(NamedTuple):
     problems: list[mdtext.Problem]
 
 
-_HEADER = re.compile(r"\[[ \t]*MC([^\]]*)\]", re.IGNORECASE)
-_ACTIVE: list = []  # the _Recovery of the parse under way
-
-
-def _raw_line(token):
-    """Read a raw block's commands as the controller reads a stored line (mercmac.mdtext);
-    its syntax errors are the parser's (one per line, and the file is not checked further)."""
-    token.value = raw = _read_raw(str(token))
-    if raw.problems and _ACTIVE and _ACTIVE[-1]:
-        _ACTIVE[-1].raw_error(token, raw.problems[0])
-    return token
-
-
 def _read_raw(text: str) -> RawLine:
     """A RAW_LINE token's commands as mercmac.mdtext reads them."""
-    header = _HEADER.match(text)
-    body = text[header.end():].split("//", 1)[0]  # a comment may end the line
+    found = mdtext.listed(text)  # grammar.lark's RAW_LINE starts with mdtext.RAW_HEADER
+    body = found.body.split("//", 1)[0]  # a comment may end the line
     commands, problems = mdtext.lex(body)
-    return RawLine(mdtext.number(header.group(1)), header.end(), commands, problems)
+    return RawLine(found.slot, found.header, commands, problems)
 
 
 class Parsed(NamedTuple):
@@ -376,14 +399,12 @@ def parse_partial(text: str, report: Report) -> Parsed:
         report.add("syntax", span, "binary")
         return Parsed(None, frozenset({span.line}), True)
     recovery = _Recovery(report, text)
-    _ACTIVE.append(recovery)
     try:
         with paused_gc():
-            tree = parser().parse(text + "\n", on_error=recovery)
+            tree = _parser().parse(text + "\n", recovery)
     except lark.UnexpectedInput as e:  # reported; recovery stopped
         tree = _finish(e) if recovery.at_end else None
     finally:
-        _ACTIVE.pop()
         recovery.flush()
     broken = frozenset(recovery.lines)
     if tree is not None and text.count("{") > MAX_NESTING:
@@ -576,24 +597,26 @@ _IN_MS = (Mnemonic.WA, Mnemonic.WS)  # commands whose argument is milliseconds (
 
 
 def nearest_keyword(word: str) -> str | None:
-    """The keyword a misspelled word most likely means (`whne` -> `when`), or None."""
-    from mercmac.suggest import distance
+    """The keyword a misspelled word most likely means (`whne` -> `when`), or None: one or
+    two edits away (mercmac.suggest), or, past three letters, its letters shuffled."""
+    from mercmac.suggest import suggest
 
     low = word.lower()
     if low in KEYWORDS:  # `When 1`: keywords are lower case
         return low if word != low else None
     if len(low) < 3:
         return None
-    limit = 1 if len(low) < 4 else 2
-    best = min(KEYWORDS, key=lambda k: (distance(low, k), k))
-    if distance(low, best) <= limit or (len(low) > 3 and sorted(low) == sorted(best)):
-        return best
-    return None
+    near = suggest(low, KEYWORDS, limit=1 if len(low) < 4 else 2)
+    if near is None and len(low) > 3:
+        nearest = suggest(low, KEYWORDS, limit=len(low) + len(max(KEYWORDS, key=len)))
+        near = nearest if sorted(low) == sorted(nearest) else None
+    return near
 
 
 def _hint(e, text: str, line: int):
     """(span, variant, values) of a syntax error that has a likely cause: a misspelled
-    keyword, `or` between conditions, a unit after a number; else None."""
+    keyword (its values hold the `fix`), `or` between conditions, a unit after a number;
+    else None."""
     token = getattr(e, "token", None)
     position = token.start_pos if token is not None else getattr(e, "pos_in_stream", None)
     if not isinstance(position, int) or position < 0 or position > len(text):
@@ -623,7 +646,8 @@ def _hint(e, text: str, line: int):
         keyword = nearest_keyword(word)
         if keyword is not None:
             span = Span(row, m.start(1) + 1, row, m.end(1) + 1)
-            return span, "keyword", {"word": word, "keyword": keyword}
+            return span, "keyword", {"word": word, "keyword": keyword,
+                                     "fix": Fix.replacing(span, keyword)}
     word = _WORD.match(code, here) if here < len(code) else None
     before = code[:here]
     if word is not None and word.group().lower() == "or" and re.search(r"\bwhen\b", before):
@@ -703,7 +727,7 @@ def _label(e) -> str | None:
     key = _key(e)
     if key is None:
         return None
-    for label, key_set in _example_keys().items():
+    for label, key_set in _parser().example_keys().items():
         if key in key_set:
             return label
     return None
@@ -715,26 +739,6 @@ def _key(e):
     if token is None or not hasattr(state, "position"):
         return None
     return state.position, token.type
-
-
-_KEYS: dict[str, set] | None = None
-
-
-def _example_keys() -> dict[str, set]:
-    global _KEYS
-    if _KEYS is None:
-        _KEYS = {}
-        for label, examples in _EXAMPLES.items():
-            keys = _KEYS.setdefault(label, set())
-            for example in examples:
-                _ACTIVE.append(None)  # not the file's errors
-                try:
-                    parser().parse(example)
-                except lark.UnexpectedInput as ex:
-                    keys.add(_key(ex))
-                finally:
-                    _ACTIVE.pop()
-    return _KEYS
 
 
 def _found(e) -> str:

@@ -5,10 +5,8 @@ show macro names, not numbers, through `Macro.name` and the spans of `Op`.
 """
 from __future__ import annotations
 
-from enum import Enum
-from typing import NamedTuple
-
 from mercmac import mdtext
+from mercmac.ops import Op, Origin
 from mercmac.source import Span
 
 MAX_COMMANDS = mdtext.MAX_COMMANDS  # MS176E §3.8: "Each macro can contain up to 16 base commands"
@@ -37,64 +35,6 @@ def wait_pieces(ms: int) -> list[int]:
     """A wait of `ms` as WA arguments of at most 65535 each, as even as can be."""
     n = max(1, -(-ms // MAX_WA))
     return [ms // n + (1 if i < ms % n else 0) for i in range(n)]
-
-
-class _Text(str, Enum):
-    """A closed set of names that reads, compares, prints and dumps to JSON as its text."""
-
-    def __str__(self) -> str:
-        return self.value
-
-    def __format__(self, spec: str) -> str:
-        return format(self.value, spec)
-
-    def __hash__(self) -> int:  # equal to its text, so it hashes as its text
-        return str.__hash__(self)
-
-
-class Role(_Text):
-    """Why an EM is there."""
-
-    NONE = ""  # not an EM
-    RAW = "raw"  # written natively
-    CALL = "call"
-    GOTO = "goto"
-    HOIST = "hoist"  # a `when`, `repeat` or `every` body moved into a macro of its own
-    CONTINUE = "continue"  # the tail EM to a macro that continues a split block or the rest
-
-
-class Origin(_Text):
-    """Where a macro came from: written by the user, made by the compiler, or read back."""
-
-    RAW = "raw"  # a `[MCnn]` block
-    MACRO = "macro"
-    AUTOSTART = "autostart"
-    WHEN = "when"  # a hoisted `when` body
-    REPEAT = "repeat"
-    EVERY = "every"
-    REST = "rest"  # the code after a hoisted block that calls out
-    PART = "part"  # a piece of a block longer than 16 commands
-    STORED = "stored"  # read from a controller (the emulator's flash memory)
-
-
-USER_ORIGINS = (Origin.RAW, Origin.MACRO, Origin.AUTOSTART)  # what the user wrote
-
-
-class Op(NamedTuple):
-    """One base command of a lowered macro.
-
-    `mnemonic` is the key of `mercmac.commands.COMMANDS` (upper case, 'FA?'
-    for queries); `arg` is None when omitted. For EM, `role` says why it is there.
-    """
-
-    mnemonic: str
-    arg: int | None = None
-    span: Span | None = None
-    role: Role = Role.NONE
-
-    @property
-    def text(self) -> str:
-        return self.mnemonic if self.arg is None else f"{self.mnemonic}{self.arg}"
 
 
 class Macro:
@@ -128,7 +68,7 @@ class Macro:
     @property
     def label(self) -> str:
         """'main (MC05)' for named macros, 'MC05' for raw ones."""
-        tag = f"MC{self.slot:02d}"
+        tag = mdtext.slot_name(self.slot)
         return tag if self.name == tag else f"{self.name} ({tag})"
 
 

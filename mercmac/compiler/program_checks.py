@@ -7,7 +7,8 @@ contradictory conditions, the 16-command limit and goto placement.
 from __future__ import annotations
 
 from mercmac.commands import Mnemonic
-from mercmac.compiler.program import MAX_COMMANDS, USER_ORIGINS, Macro, Op, Origin, Program, Role
+from mercmac.compiler.program import MAX_COMMANDS, Macro, Program
+from mercmac.ops import USER_ORIGINS, Op, Origin, Role
 from mercmac.diagnostics import Report, Severity
 
 _CONDITIONS = (Mnemonic.XN, Mnemonic.XF)

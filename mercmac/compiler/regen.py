@@ -2,7 +2,7 @@
 
 Run `python -m mercmac.compiler.regen` after editing the grammar. The
 generated module needs no lark at run time, which keeps `mercmac check` fast
-to start; `tests/test_grammar.py` checks that it matches the grammar.
+to start; `tests/compiler/test_grammar.py` checks that it matches the grammar.
 """
 from __future__ import annotations
 

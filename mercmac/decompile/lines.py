@@ -1,7 +1,6 @@
 """A stored program read back: its lines as ops, who calls whom, and names for its macros."""
 from __future__ import annotations
 
-import re
 from typing import NamedTuple
 
 from mercmac import mdtext
@@ -13,8 +12,6 @@ CYCLE_MS = 1  # SPEC §3 Time: each executed command takes one controller cycle,
 # Commands that take one cycle and go on; a wait for the motor or an input, a condition that
 # may leave, a call and macro management take what the machine makes of them.
 _ONE_CYCLE = (Kind.MOTION, Kind.OUTPUT, Kind.SETTING, Kind.REPORT, Kind.REPEAT)
-_HEADER = re.compile(r"\s*(?:\[\s*MC\s*\+?\s*(\d+)\s*\]|MC\s*(\d+)\b|MD\s*(\d+)\s*(?:,|$))(.*)",
-                     re.IGNORECASE)
 
 
 class Line(NamedTuple):
@@ -32,10 +29,9 @@ def read_macros(text: str) -> dict[int, str]:
     """The macros of a `[MCnn]` file, `MDn,...` lines or a `TM` report, by slot (last wins)."""
     macros: dict[int, str] = {}
     for raw in split_lines(text):
-        m = _HEADER.match(raw.split("//", 1)[0])
-        if m and any(m.group(i) for i in (1, 2, 3)):
-            slot = int(next(g for g in m.groups()[:3] if g))
-            macros[slot] = m.group(4).strip()
+        found = mdtext.listed(raw.split("//", 1)[0].lstrip())
+        if found is not None and found.slot is not None:
+            macros[found.slot] = found.body.strip()
     return macros
 
 
@@ -197,7 +193,7 @@ def _name(line: Line, mode: str | None, from_autostart: bool) -> str:
         return "dispatch"
     if mnemonics & {Mnemonic.MA, Mnemonic.MR, Mnemonic.GH}:
         return "move"
-    return f"mc{line.slot:02d}"
+    return mdtext.slot_name(line.slot).lower()
 
 
 __all__ = ["C663", "C863", "Line", "Runs", "read_macros", "read_lines", "model_of", "names", "runs"]

@@ -6,8 +6,9 @@ import json
 import re
 
 from mercmac.commands import C663, Mnemonic, lookup
-from mercmac.render.sim import duration, plural
-from mercmac.timespec import format_duration
+from mercmac.mdtext import slot_name
+from mercmac.render.sim import plural
+from mercmac.timespec import format_span
 from mercmac.decompile.lines import (Line, condition_run, every_period, model_of, names,
                                      read_lines, runs)
 
@@ -22,15 +23,15 @@ class _Reader:
         self.unit = _UNITS.get(self.model, "counts") if self.model else "counts"
         # The source's names, as `sim` and `flash` show them (Macro.label); a raw slot's
         # name is its tag, and it gets a name made from what it does instead.
-        self.given = {s: n for s, n in (given or {}).items() if n != f"MC{s:02d}"}
+        self.given = {s: n for s, n in (given or {}).items() if n != slot_name(s)}
         self.names = names(self.lines, self.given)
 
     # -- words for one line -------------------------------------------------------------------------
     def label(self, slot: int) -> str:
         """'jog (MC01)' for a macro the source names, 'MC01 (mode_1)' for a raw one."""
         if slot in self.given and slot in self.lines:
-            return f"{self.names[slot]} (MC{slot:02d})"
-        return f"MC{slot:02d} ({self.names[slot]})" if slot in self.lines else f"MC{slot:02d}"
+            return f"{self.names[slot]} ({slot_name(slot)})"
+        return f"{slot_name(slot)} ({self.names[slot]})" if slot in self.lines else slot_name(slot)
 
     def words(self, line: Line) -> str:
         if line.ops is None:
@@ -79,7 +80,7 @@ class _Reader:
         if m == Mnemonic.EM:
             target = self.lines.get(n)
             if target is None:
-                return f"run MC{n:02d} (not defined: nothing happens)"
+                return f"run {slot_name(n)} (not defined: nothing happens)"
             run = condition_run(target.ops)
             when = f" if {_condition(run, at_start=True)}" if run and len(run) < len(target.ops) else ""
             return ("go to " if tail else "run ") + self.label(n) + when
@@ -203,7 +204,7 @@ def _repeats(ops) -> bool:
 
 def _length(ms: int) -> str:
     """'92 ms' when that is exact, else 'about 1,094 d' (three digits, as the timeline)."""
-    rounded, exact = duration(ms * 1000), format_duration(ms)
+    rounded, exact = format_span(ms * 1000), format_span(ms * 1000, digits=None)
     return exact if len(exact) <= len(rounded) else f"about {rounded}"
 
 
@@ -336,15 +337,15 @@ def _node(reader: _Reader, s: int) -> str:
     found = runs(reader.lines[s], reader.lines)
     loop = f"every {period} ms" if period is not None else "" if found is None else \
         f"repeat {'' if found.exact else 'up to '}{found.times:,} times"
-    return f"MC{s:02d} {reader.names[s]}" + (f" ({loop})" if loop else "")
+    return f"{slot_name(s)} {reader.names[s]}" + (f" ({loop})" if loop else "")
 
 
 def _mermaid(reader: _Reader) -> str:
     out = ["graph TD"]
     for s in reader.lines:
-        out.append(f'    MC{s:02d}["{_node(reader, s)}"]')
+        out.append(f'    {slot_name(s)}["{_node(reader, s)}"]')
     for s, t, label, tail in _edges(reader):
-        out.append(f"    MC{s:02d} {'-.->' if tail else '-->'}|{label}| MC{t:02d}")
+        out.append(f"    {slot_name(s)} {'-.->' if tail else '-->'}|{label}| {slot_name(t)}")
     return "\n".join(out)
 
 
@@ -356,9 +357,9 @@ def call_graph_dot(macros: dict[int, str], *, model: str | None = None,
     out = ["digraph macros {", "    rankdir=LR;", "    node [shape=box];",
            "    edge [fontsize=10];"]
     for s in reader.lines:
-        out.append(f'    MC{s:02d} [label="{_node(reader, s).replace(" ", chr(92) + "n", 1)}"];')
+        out.append(f'    {slot_name(s)} [label="{_node(reader, s).replace(" ", chr(92) + "n", 1)}"];')
     for s, t, label, tail in _edges(reader):
         style = ", style=dashed" if tail else ""
-        out.append(f'    MC{s:02d} -> MC{t:02d} [label="{label}"{style}];')
+        out.append(f'    {slot_name(s)} -> {slot_name(t)} [label="{label}"{style}];')
     out.append("}")
     return "\n".join(out) + "\n"

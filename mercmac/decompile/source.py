@@ -8,14 +8,18 @@ is checked by compiling the whole source and comparing the slots.
 """
 from __future__ import annotations
 
+import functools
 from collections import Counter
 from typing import NamedTuple
 
 from mercmac import mdtext
 from mercmac.commands import Mnemonic
+from mercmac.compiler import ast
 from mercmac.decompile.lines import (CONDITIONS, Line, condition_run, every_period, model_of,
                                      names, read_lines)
 from mercmac.diagnostics import Severity
+from mercmac.fmt import printer
+from mercmac.fmt.printer import Comment, Commented, RawText, Run
 from mercmac.render.report import printable
 
 RAW, NATIVE, PLAIN, FOLD = 0, 1, 2, 3  # how richly a slot is written
@@ -33,7 +37,8 @@ _LOOP_STOP = (Mnemonic.RP, Mnemonic.TI)  # what a loop body may not hold (RP, TI
 
 
 class _Writer:
-    """Writes the source for one choice of levels (slot -> RAW..FOLD) and pins."""
+    """Writes the source for one choice of levels (slot -> RAW..FOLD) and pins: a tree of
+    mercmac.compiler.ast, printed by mercmac.fmt.printer. Nodes built here have no span."""
 
     def __init__(self, lines: dict[int, Line], names: dict[int, str], model: str | None):
         self.lines, self.names, self.model = lines, names, model
@@ -77,8 +82,7 @@ class _Writer:
                     if self._rest(rest, ops, i, line.slot, op.arg) and len(run) < len(helper) - 1:
                         # a `when` that calls out, and the rest of the line after it
                         out[op.arg] = out[rest] = line.slot
-                        self.loops[op.arg] = (f"when {_conditions(run)}", helper[len(run):-1],
-                                              rest, False)
+                        self.loops[op.arg] = (_when(run, ()), helper[len(run):-1], rest, False)
                     elif i < len(ops) - 1:  # a tail `when` would stand in its caller's line
                         out[op.arg] = line.slot
                 elif loop and i and not _stops(ops[:i]) and every_period(ops) is None:
@@ -104,16 +108,17 @@ class _Writer:
                 and slot in self.fold_ok and slot not in self.too_deep)
 
     def _loop(self, slot: int) -> tuple | None:
-        """(head, body, rest slot) of a hoisted `repeat N`/`every T` line, else None."""
+        """(block without its body, body ops, rest slot, True) of a hoisted `repeat N`/`every T`
+        line, else None."""
         ops = list(self.lines[slot].ops)
         rest = None
         if ops and ops[-1].mnemonic == Mnemonic.EM:
             rest, ops = ops[-1].arg, ops[:-1]
         period = every_period(ops)
         if period is not None:
-            head, body = f"every {period}ms", ops[:-3]
+            head, body = ast.Every(_number(period), (), None), ops[:-3]
         elif ops and ops[-1].mnemonic == Mnemonic.RP and ops[-1].arg:
-            head, body = f"repeat {ops[-1].arg + 1}", ops[:-1]
+            head, body = ast.Repeat(_number(ops[-1].arg + 1), (), None), ops[:-1]
         else:
             return None
         if not body or _stops(body) or any(o.mnemonic in CONDITIONS for o in body):
@@ -122,88 +127,91 @@ class _Writer:
 
     # -- the text -----------------------------------------------------------------------------------
     def text(self) -> str:
+        return printer.module(self.items())
+
+    def items(self) -> list:
+        """The file's items: a header comment, `target`, then each slot not folded away."""
         self.folded = self.folds()
-        out = ["// Decompiled by mercmac: each macro names the slot it came from."]
+        out: list = [Comment("// Decompiled by mercmac: each macro names the slot it came from.")]
         if self.model:
-            out.append(f"target {self.model}")
-        for slot, line in sorted(self.lines.items()):
-            if slot in self.folded:
-                continue
-            out.append("")
-            out += self.item(line)
-        return "\n".join(out) + "\n"
+            out.append(ast.Target(self.model, None))
+        out += [self.item(line) for slot, line in sorted(self.lines.items())
+                if slot not in self.folded]
+        return out
 
-    def item(self, line: Line) -> list[str]:
-        level = self.levels[line.slot]
-        tag = f"MC{line.slot:02d}"
+    def item(self, line: Line):
+        """A slot as a raw block, or as a macro (or autostart) commented with its slot."""
+        level, slot = self.levels[line.slot], line.slot
         if level == RAW:
-            why = self.why.get(line.slot)
-            return [f"[{tag}] {line.text}" + (f"   // kept raw: {why}" if why else "")]
-        head = "autostart" if line.slot == 0 else f"macro {self.names[line.slot]}" + (
-            f" @{line.slot}" if self.pinned[line.slot] else "")
-        body = self.native(line.ops) if level == NATIVE else self.whole(line)
-        return [f"{head} {{   // {tag}"] + _indent(body) + ["}"]
+            why = self.why.get(slot)
+            node = RawText(slot, line.text) if line.ops is None else ast.RawBlock(
+                slot, tuple(map(_command, line.ops)), None)
+            return Commented(node, f"// kept raw: {why}") if why else node
+        body = tuple(self.native(line.ops) if level == NATIVE else self.whole(line))
+        node = ast.Autostart(body, None) if slot == 0 else ast.MacroDef(
+            self.names[slot], _number(slot) if self.pinned[slot] else None, body, None)
+        return Commented(node, _tag(slot))
 
-    def whole(self, line: Line) -> list[str]:
+    def whole(self, line: Line) -> list:
         """A line at its start: a loop that starts it, then what follows."""
         ops = list(line.ops)
         for i, op in enumerate(ops):
             if op.mnemonic == Mnemonic.RP:
                 period = every_period(ops[:i + 2])
                 if period is not None and i > 1 and not _stops(ops[:i - 1]):
-                    return (_block(f"every {period}ms", self.seq(ops[:i - 1], loop=True))
-                            + self.seq(ops[i + 2:], loop=False))
+                    body = tuple(self.seq(ops[:i - 1], loop=True))
+                    return [ast.Every(_number(period), body, None),
+                            *self.seq(ops[i + 2:], loop=False)]
                 if op.arg and i and not _stops(ops[:i]) and not condition_run(ops[:i]):
-                    return (_block(f"repeat {op.arg + 1}", self.seq(ops[:i], loop=True))
-                            + self.seq(ops[i + 1:], loop=False))
+                    body = tuple(self.seq(ops[:i], loop=True))
+                    return [ast.Repeat(_number(op.arg + 1), body, None),
+                            *self.seq(ops[i + 1:], loop=False)]
                 break
         return self.seq(ops, loop=False)
 
-    def seq(self, ops: list, loop: bool, hoisted: bool = False) -> list[str]:
+    def seq(self, ops: list, loop: bool, hoisted: bool = False) -> list:
         """Statements for ops; `hoisted`: in a block that its own macro holds, where a tail
         `call` would make the compiler continue the caller in another macro: a `goto`."""
-        out: list[str] = []
+        out: list = []
         for i, op in enumerate(ops):
             last = i == len(ops) - 1
             run = condition_run(ops[i:])
             if run and not loop and len(run) < len(ops) - i:
                 body = self.seq(ops[i + len(run):], loop=False, hoisted=hoisted)
-                return out + _block(f"when {_conditions(run)}", body)
+                return out + [_when(run, body)]
             before = _em_to(ops[i - 1]) if i else None
             if before in self.loops and before in self.folded and self.loops[before][2] == op.arg:
                 continue  # the rest after a folded loop is written after it
             if op.mnemonic == Mnemonic.EM:
                 out += self.em(op.arg, last and not loop, hoisted)
             else:
-                out.append(_native(op))
+                out.append(_command(op))
         return out
 
-    def em(self, slot: int, tail: bool, hoisted: bool = False) -> list[str]:
+    def em(self, slot: int, tail: bool, hoisted: bool = False) -> list:
         if slot in self.loops and slot in self.folded:
             head, body, rest, loop = self.loops[slot]
-            block = _block(head, self.seq(list(body), loop=loop))
-            block[0] += f"   // MC{slot:02d}"
+            block = head._replace(body=tuple(self.seq(list(body), loop=loop)))
+            block = Commented(block, _tag(slot))
             if rest is None:
-                return block
-            return block + [f"// MC{rest:02d}:"] + self.whole(self.lines[rest])
+                return [block]
+            return [block, Comment(f"{_tag(rest)}:"), *self.whole(self.lines[rest])]
         if slot in self.folded:
             helper = self.lines[slot].ops
             run = condition_run(helper)
             body = self.seq(list(helper[len(run):]), loop=False, hoisted=True)
-            block = _block(f"when {_conditions(run)}", body)
-            block[0] += f"   // MC{slot:02d}"
-            return block
+            return [Commented(_when(run, body), _tag(slot))]
         line = self.lines.get(slot)
         if line is None or self.levels.get(slot, RAW) == RAW or slot == 0:
-            return [f"{Mnemonic.EM} {slot}"]
+            return [_em(slot)]
         calls_on = bool(line.ems())
         if tail:
             goto = hoisted or calls_on or _never_returns(line)
-            return [f"{'goto' if goto else 'call'} {self.names[slot]}"]
-        return [f"{Mnemonic.EM} {slot}"] if calls_on else [f"call {self.names[slot]}"]
+            return [(ast.Goto if goto else ast.Call)(self.names[slot], None)]
+        return [_em(slot)] if calls_on else [ast.Call(self.names[slot], None)]
 
-    def native(self, ops) -> list[str]:
-        return [", ".join(_native(op) for op in ops)]
+    def native(self, ops) -> list:
+        return [Run(tuple(map(_command, ops)))]
 
 
 def _depths(folded: dict[int, int]) -> dict[int, int]:
@@ -230,37 +238,39 @@ def _stops(ops) -> bool:
     return any(op.mnemonic in _LOOP_STOP for op in ops)
 
 
-def _native(op) -> str:
-    return op.mnemonic if op.arg is None else f"{op.mnemonic} {op.arg}"
+# A candidate is a tree of a few hundred nodes, most of them the last candidate's: each
+# number and command is made once (benchmarks/decompile_speed.py).
+@functools.lru_cache(maxsize=4096)
+def _number(n: int) -> ast.Number:
+    return ast.Number(n, None)
 
 
-def _conditions(run) -> str:
-    return " and ".join(("not " if op.mnemonic == Mnemonic.XF else "") + str(op.arg) for op in run)
+def _command(op) -> ast.Command:
+    return _native(op.mnemonic, op.arg)
 
 
-def _block(head: str, body: list[str]) -> list[str]:
-    body = _joined(body)
-    if len(body) == 1 and "{" not in body[0] and len(head) + len(body[0]) < 72:
-        return [f"{head} {{ {body[0]} }}"]
-    return [f"{head} {{"] + _indent(body) + ["}"]
+@functools.lru_cache(maxsize=4096)
+def _native(mnemonic: str, arg: int | None) -> ast.Command:
+    return ast.Command(mnemonic, None if arg is None else _number(arg), None, None)
 
 
-def _joined(body: list[str]) -> list[str]:
-    """Runs of simple statements on one line, `MR 5000, WS 100`, up to about 76 characters."""
-    out: list[str] = []
-    simple = False
-    for s in body:
-        plain = not s.startswith((" ", "//")) and "{" not in s and s != "}"
-        if plain and simple and len(out[-1]) + len(s) < 70:
-            out[-1] += ", " + s
-        else:
-            out.append(s)
-        simple = plain
-    return out
+def _em(slot: int) -> ast.Command:
+    return _native(Mnemonic.EM, slot)
 
 
-def _indent(lines: list[str]) -> list[str]:
-    return ["    " + s for s in _joined(lines)]
+def _when(run, body) -> ast.When:
+    """`when 1 and not 2 { body }` for a run of XN1,XF2."""
+    return ast.When(_conditions(tuple(run)), tuple(body), None)
+
+
+@functools.lru_cache(maxsize=1024)
+def _conditions(run: tuple) -> tuple[ast.Condition, ...]:
+    return tuple(ast.Condition(_number(op.arg), op.mnemonic == Mnemonic.XF, None) for op in run)
+
+
+def _tag(slot: int) -> str:
+    """The comment that names the slot a block came from: `// MC05`."""
+    return f"// {mdtext.slot_name(slot)}"
 
 
 # -- checking a candidate ---------------------------------------------------------------------------
@@ -403,10 +413,11 @@ def _unpin(search: _Search, group: list[int] | None = None) -> None:
 def _finish(writer: _Writer, origin: str) -> str:
     from mercmac.fmt import format_text
 
-    text = writer.text()
+    items = writer.items()
     if origin:  # escaped: a name with a line end must not end the comment (issue 20, item 18)
-        text = f"// Read from {printable(origin)}.\n" + text
-    try:
+        items.insert(0, Comment(f"// Read from {printable(origin)}."))
+    text = printer.module(items)
+    try:  # the printer's layout is fmt's; fmt reads a `//` in a raw block's line as a comment
         return format_text(text)
     except Exception:  # a raw block that does not parse keeps the text as written
         return text

@@ -2,4 +2,5 @@
 
     virtual.py     VirtualController: the firmware's serial front end over the VM
     ptyserver.py   serves it on a pseudo-terminal that opens like a serial port
+    faults.py      Faults: how it misbehaves on demand, as real links do
 """

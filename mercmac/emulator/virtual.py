@@ -7,8 +7,8 @@ it are read (hosts pipeline: `MA10000\rTS\r` in one write), and the macro
 commands (MD, RM, RMALL, RZ, TM, TZ). Everything
 else (motion, waits, reports, TS, TB, VE, running stored macros) is the
 simulator's VM, `mercmac.vm.Machine`, advanced with wall time; its reports
-module formats every report. `Faults` makes it misbehave the way real links
-do. ptyserver.py serves it on a pseudo-terminal.
+module formats every report. `Faults` (faults.py) makes it misbehave the way
+real links do. ptyserver.py serves it on a pseudo-terminal.
 
 Nothing a host sends stops it: a line it cannot take is refused with the
 firmware's TS error code (02, 05, 06), and a `--state` file it cannot read is
@@ -19,14 +19,15 @@ from __future__ import annotations
 import json
 import logging
 from collections import deque
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
 from mercmac import mdtext
 from mercmac.commands import C863, SINGLE_CHARS, Mnemonic
-from mercmac.compiler.program import Macro, Op, Origin, Program
-from mercmac.errors import UsageError
+from mercmac.compiler.program import Macro, Program
+from mercmac.ops import Op, Origin
+from mercmac.emulator.faults import EmptySlot, Faults, Framing
+from mercmac.errors import InputError
 from mercmac import outfile
 from mercmac.outfile import OutputError, writable_target, write_text
 from mercmac.upload import protocol
@@ -63,32 +64,12 @@ _STATE_KEYS = ("model", "macros")
 log = logging.getLogger(__name__)
 
 
-class StateError(UsageError):
+class StateError(InputError):
     """A `--state` file the emulator cannot read or keep; it is left as it is (exit 2)."""
 
 
 class BadLine(ValueError):
     """A command line the controller refuses (error 05 in MD, 06 in direct mode); says why."""
-
-
-@dataclass(slots=True)
-class Faults:
-    """Misbehaviour on demand, for the uploader's fault tests (issue 4, item 5)."""
-
-    drop_char: dict[int, int] = field(default_factory=dict)  # n-th MD line (1-based) -> index lost
-    always_drop_slot: int | None = None  # every MD line for this slot loses a character
-    vanish_after_md: int | None = None  # the port disappears after this many MD lines
-    tm_framing: str = "etx-per-line"  # or "one-etx": how a TM listing of several macros ends
-    empty_slot: str = "empty"  # or "bare": TMn of an empty slot is "" or "MCnnn" (SPEC §4)
-    silent: bool = False  # nothing answers at all
-    garble: bool = False  # replies arrive mangled, as at a wrong baud rate
-    char_gap: bool | None = None  # enforce the 20 ms gap; None = as the firmware version says
-    md_delay: float = 0.0  # seconds a flash write keeps the controller from reading on
-    # like real hardware: bytes reach the firmware at `baud`, firmware 1.xx's 20 ms gap holds
-    # whatever VE says, and characters are lost while a move runs (MOVE_POLL_S)
-    pace: bool = False
-    baud: int = 9600
-    version: str | None = None  # VE answers this instead (older firmware, the C-862)
 
 
 class VirtualController:
@@ -392,16 +373,18 @@ class VirtualController:
 
     def _tell(self, slots: list[int], listing: bool = False) -> None:
         """TM/TZ answers, framed as `Faults` says (SPEC §4 leaves both open)."""
-        lines = protocol.lines(reports.macros(self.machine, slots))
-        if not lines and not listing and self.faults.empty_slot == "bare":
-            lines = [f"MC{slots[0]:03d}"]
+        lines = protocol.lines(reports.macros(self.machine.stored_macros(), slots))
+        if not lines and not listing and self.faults.empty_slot is EmptySlot.BARE:
+            lines = [mdtext.tm_line(slots[0])]
         if not lines:
             self.report("")  # an empty report
-        elif self.faults.tm_framing == "one-etx":
-            self.report("\r\n".join(lines))
-        else:
-            for line in lines:
-                self.report(line)
+            return
+        match self.faults.tm_framing:
+            case Framing.ONE_ETX:
+                self.report("\r\n".join(lines))
+            case Framing.ETX_PER_LINE:
+                for line in lines:
+                    self.report(line)
 
     def _save(self) -> None:
         """Write a changed flash memory to the state file; if that fails, the change is undone."""
@@ -440,7 +423,7 @@ def _ops(line: str, slot: int, model: str | None = None) -> list[Op]:
 
 
 def _macro(slot: int, ops: list[Op]) -> Macro:
-    return Macro(slot, f"MC{slot:02d}", ops, origin=Origin.STORED)
+    return Macro(slot, mdtext.slot_name(slot), ops, origin=Origin.STORED)
 
 
 def _state_target(path: Path) -> Path:

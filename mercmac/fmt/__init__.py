@@ -22,6 +22,8 @@ between tokens and the spelling of a few tokens, never the program:
 - the file's line ends stay: every line ends with the file's most common line end
   (LF, CRLF or CR: mercmac.source.LINE_END; the first one on a tie), LF when it has none.
 
+The spelling, blanks, indentation and comment columns are mercmac.fmt.layout's, which the
+AST printer (mercmac.fmt.printer) shares; this module reads a user's file into lines.
 A file that does not parse is not formatted: `format_text` raises FormatError.
 `load` reads a file's bytes as text only when writing that text back gives the same bytes
 (issue 20): a byte its encoding does not have is an error, never a U+FFFD written back.
@@ -29,39 +31,21 @@ A file that does not parse is not formatted: `format_text` raises FormatError.
 from __future__ import annotations
 
 import re
-from typing import Iterator, NamedTuple
+from typing import Iterator
 
 from mercmac import mdtext
 from mercmac.errors import MercmacError
+from mercmac.fmt.layout import Line, render, space, spell
 from mercmac.source import LINE_END, Encoding, to_lf
 
-INDENT = "    "
 # MMCRun leaves three blank lines after its header comment (MS176E §3.8.6, Example 4).
 MAX_BLANK_LINES = 3
-# The examples' house style: three spaces between the longest code of a run of
-# commented lines and the column of its comments.
-COMMENT_GAP = "   "
-# Longer code is not aligned with its neighbours: padding 10,000 short lines to the column
-# of one 1 MB line would write 10 GB (issue 20's hostile files).
-ALIGN_WIDTH = 100
 
-_HEADER = re.compile(r"\[[ \t]*MC([^\]]*)\]", re.IGNORECASE)
 _BLANKS = re.compile(r"[ \t\f\v]+")
-# Tokens written with their blanks dropped; MNEMONIC and MODEL also upper case.
-_SQUEEZE = {"INT", "DURATION", "MNEMONIC", "MODEL"}
-_UPPER = {"MNEMONIC", "MODEL"}
-_NO_SPACE_BEFORE = {"COMMA"}
-_NO_SPACE_AFTER = {"AT"}
 
 
 class FormatError(MercmacError):
     """A file that cannot be formatted because it does not parse; nothing was changed."""
-
-
-class _Line(NamedTuple):
-    depth: int
-    code: str
-    comment: str
 
 
 def format_text(text: str) -> str:
@@ -73,7 +57,7 @@ def format_text(text: str) -> str:
     reads = _Reads()
     with paused_gc():  # a token per few bytes, none in a cycle: see paused_gc
         items = _items(text)
-        formatted = _render(list(_lines(items, reads)))
+        formatted = render(list(_lines(items, reads)))
         if formatted != text:  # the same text reads the same: the guard has nothing to see
             _same_program(items, formatted, reads)
     return formatted if newline == "\n" else formatted.replace("\n", newline)
@@ -106,7 +90,7 @@ def _items(text: str) -> list[tuple[str, str]]:
                           hint="`mercmac check` says what is wrong") from None
 
 
-def _lines(items: list, reads: _Reads) -> Iterator[_Line | None]:
+def _lines(items: list, reads: _Reads) -> Iterator[Line | None]:
     """The formatted lines; None for a blank line."""
     depth = 0
     line_depth = 0
@@ -118,7 +102,7 @@ def _lines(items: list, reads: _Reads) -> Iterator[_Line | None]:
     for kind, value in items:
         if kind == "_NL":
             if parts or comment:
-                yield _Line(line_depth, "".join(parts), comment)
+                yield Line(line_depth, "".join(parts), comment)
             blanks = min(value.count("\n") - 1, MAX_BLANK_LINES)
             if started:
                 yield from [None] * blanks
@@ -139,68 +123,14 @@ def _lines(items: list, reads: _Reads) -> Iterator[_Line | None]:
             code, comment = _raw_line(value, reads)
             parts.append(code)
         else:
-            parts.append(_space(previous, kind) + _spell(kind, value))
+            parts.append(space(previous, kind) + spell(kind, value))
         depth += _DEPTH.get(kind, 0)
         previous = kind
     if parts or comment:
-        yield _Line(line_depth, "".join(parts), comment)
+        yield Line(line_depth, "".join(parts), comment)
 
 
 _DEPTH = {"LBRACE": 1, "RBRACE": -1}
-
-
-def _space(previous: str | None, kind: str) -> str:
-    if previous is None or kind in _NO_SPACE_BEFORE or previous in _NO_SPACE_AFTER:
-        return ""
-    return " "
-
-
-def _spell(kind: str, value: str) -> str:
-    """A token as the canonical layout writes it."""
-    if kind in _SQUEEZE and (" " in value or "\t" in value):
-        value = _BLANKS.sub("", value)
-    if kind in _UPPER:
-        value = value.upper()
-    if kind == "DURATION":
-        value = value.lower()  # units read in any case (mercmac.timespec)
-    return value
-
-
-def _render(lines: list[_Line | None]) -> str:
-    while lines and lines[-1] is None:
-        lines.pop()
-    codes = ["" if line is None else INDENT * max(line.depth, 0) + line.code for line in lines]
-    columns = _comment_columns(lines, codes)
-    out = [code.ljust(column) + (line.comment if line else "")
-           for line, code, column in zip(lines, codes, columns)]
-    return "".join(line + "\n" for line in out)
-
-
-def _comment_columns(lines: list[_Line | None], codes: list[str]) -> list[int]:
-    """Where each line's comment starts: for a run of consecutive lines that each end in a
-    comment, COMMENT_GAP after the run's longest code; 0 (right after the code) elsewhere.
-    A line longer than ALIGN_WIDTH is a run of its own."""
-    columns = [0] * len(lines)
-    start = 0
-    for end in range(len(lines) + 1):
-        if end < len(lines) and _trailing(lines[end]) and len(codes[end]) <= ALIGN_WIDTH:
-            continue
-        _align(columns, codes, range(start, end))
-        if end < len(lines) and _trailing(lines[end]):
-            _align(columns, codes, range(end, end + 1))
-        start = end + 1
-    return columns
-
-
-def _align(columns: list[int], codes: list[str], run: range) -> None:
-    if run:
-        column = max(len(codes[i]) for i in run) + len(COMMENT_GAP)
-        columns[run.start:run.stop] = [column] * len(run)
-
-
-def _trailing(line: _Line | None) -> bool:
-    """Whether a line has code and a comment after it."""
-    return line is not None and bool(line.code) and bool(line.comment)
 
 
 # -- raw blocks ---------------------------------------------------------------------------------
@@ -216,12 +146,13 @@ class _Reads(dict):
 
 def _raw_line(text: str, reads: _Reads) -> tuple[str, str]:
     """A `[MCnn] ...` line as MMCRun writes it, and the comment that ends it."""
-    header = _HEADER.match(text)
-    rest = text[header.end():]
-    body, slash, comment = rest.partition("//")
+    found = mdtext.listed(text)  # grammar.lark's RAW_LINE starts with mdtext.RAW_HEADER
+    body, slash, comment = found.body.partition("//")
     comment = (slash + comment).rstrip()
-    slot = mdtext.number(header.group(1))
-    head = f"[MC{slot:02d}]" if slot is not None else "[MC" + _BLANKS.sub("", header.group(1)) + "]"
+    if found.slot is not None:
+        head = f"[{mdtext.slot_name(found.slot)}]"
+    else:  # more digits than any number: as written, blanks dropped
+        head = "[MC" + _BLANKS.sub("", text[1:found.header - 1])[2:] + "]"
     body = _raw_body(body, reads)
     return (f"{head} {body}" if body else head), comment
 
@@ -268,17 +199,17 @@ def _same_program(items: list, formatted: str, reads: _Reads) -> None:
     """The formatted text must read as the same tokens (blanks and line breaks aside), each
     already in its canonical spelling, or the formatter has a bug: refuse rather than change
     a program (black's --safe)."""
-    if _meaning(items, reads) != _meaning(_items(formatted), reads, spell=False):
+    if _meaning(items, reads) != _meaning(_items(formatted), reads, spelled=False):
         raise FormatError("internal error: formatting would change the program; not formatted",
                           hint="please report this file")
 
 
-def _meaning(items: list, reads: _Reads, spell: bool = True) -> tuple[list, list]:
-    """The comments, and each token in its canonical spelling (SPELL; formatted text has it
+def _meaning(items: list, reads: _Reads, spelled: bool = True) -> tuple[list, list]:
+    """The comments, and each token in its canonical spelling (SPELLED; formatted text has it
     already) or, for a raw block, its slot, what its commands say and its comment."""
     comments = [value.rstrip() for kind, value in items if kind == "COMMENT"]
     code = [_raw_meaning(value, reads) if kind == "RAW_LINE" else
-            (kind, _spell(kind, value) if spell else value)
+            (kind, spell(kind, value) if spelled else value)
             for kind, value in items if kind not in _LAYOUT]
     return comments, code
 
@@ -287,9 +218,9 @@ _LAYOUT = frozenset({"_NL", "COMMENT"})
 
 
 def _raw_meaning(line: str, reads: _Reads) -> tuple:
-    header = _HEADER.match(line)
-    body, _, comment = line[header.end():].partition("//")
-    return mdtext.number(header.group(1)), reads[body], comment.rstrip()
+    found = mdtext.listed(line)
+    body, _, comment = found.body.partition("//")
+    return found.slot, reads[body], comment.rstrip()
 
 
 # -- files --------------------------------------------------------------------------------------

@@ -14,7 +14,6 @@ from __future__ import annotations
 import asyncio
 import logging
 import os
-import re
 import sys
 from typing import Callable
 
@@ -28,18 +27,18 @@ from pygls.lsp.server import LanguageServer
 from mercmac import __version__, config
 from mercmac.commands import MODELS, Mnemonic
 from mercmac.compiler import Compilation, checking
-from mercmac.diagnostics import Diagnostic, Severity
-from mercmac.errors import MercmacError, UsageError
+from mercmac.diagnostics import Diagnostic, Fix, Severity
+from mercmac.errors import MercmacError, SettingsError
 from mercmac.lsp import completion as completion_rules, framing, settings, symbols
 from mercmac.lsp.document import Document, Documents
 from mercmac.lsp.recheck import Checked, Rechecker
+from mercmac.mdtext import slot_name
 from mercmac.render.report import capped
-from mercmac.source import LINE_END, Source, Span, split_lines
+from mercmac.source import Source, Span, split_lines
 
 _SEVERITY = {Severity.ERROR: t.DiagnosticSeverity.Error,
              Severity.WARNING: t.DiagnosticSeverity.Warning,
              Severity.INFO: t.DiagnosticSeverity.Information}
-_QUOTED = re.compile(r"'([^']+)'")
 # Diagnostics sent per document: an editor lists them all, and past a thousand it slows
 # down (a 2.5 MB file gave 288,000 of 700 bytes each, issue 20) while no one reads them.
 MAX_DIAGNOSTICS = 1000
@@ -185,7 +184,7 @@ class MercmacServer(LanguageServer):
         path = uris.to_fs_path(uri) if uri.startswith("file:") else None
         try:
             return checking.choice_for(path, self.options)
-        except UsageError as e:
+        except SettingsError as e:
             self.tell(f"{e.message} ({e.hint})" if e.hint else e.message)
             return checking.choice_for(None, self.options)
 
@@ -516,12 +515,12 @@ def document_symbols(ls: MercmacServer, params: t.DocumentSymbolParams) -> list[
             slots = symbols.slots_of(name, program) if program else []
             out.append(t.DocumentSymbol(
                 name=name, kind=t.SymbolKind.Function, range=whole, selection_range=chosen,
-                detail=", ".join(f"MC{m.slot:02d}" for m in slots),
-                children=[t.DocumentSymbol(name=f"MC{m.slot:02d}", kind=t.SymbolKind.Field,
+                detail=", ".join(slot_name(m.slot) for m in slots),
+                children=[t.DocumentSymbol(name=slot_name(m.slot), kind=t.SymbolKind.Field,
                                            range=whole, selection_range=whole, detail=m.line)
                           for m in slots]))
         elif isinstance(item, ast.RawBlock):
-            out.append(t.DocumentSymbol(name=f"MC{item.slot:02d}", kind=t.SymbolKind.Function,
+            out.append(t.DocumentSymbol(name=slot_name(item.slot), kind=t.SymbolKind.Function,
                                         range=whole, selection_range=whole, detail="raw block"))
         elif isinstance(item, ast.Const):
             out.append(t.DocumentSymbol(name=item.name, kind=t.SymbolKind.Constant,
@@ -555,25 +554,25 @@ def formatter():
 @server.feature(t.TEXT_DOCUMENT_CODE_ACTION,
                 t.CodeActionOptions(code_action_kinds=[t.CodeActionKind.QuickFix, ADD_TARGET]))
 def code_actions(ls: MercmacServer, params: t.CodeActionParams) -> list[t.CodeAction]:
-    """The safe fixes of the reported diagnostics in the range (a "did you mean"
-    replacement); in a file without `target`, a source action that adds one."""
+    """The fixes of the reported diagnostics in the range (the Fix data of each, as
+    `check --fix` makes them); in a file without `target`, a source action that adds one."""
     uri = params.text_document.uri
     seen, document = ls.checked(uri), ls.workspace.get_text_document(uri)
     wanted = (document.spot(params.range.start), document.spot(params.range.end))
     out = []
     if _wanted(params.context.only, t.CodeActionKind.QuickFix):
-        for d in seen.diagnostics:
-            fix = _replacement(d, seen.compilation.source, document) if _touches(
-                d.span, *wanted) else None
-            if fix is not None:
-                edit, new = fix
-                out.append(t.CodeAction(
-                    title=f"Replace with '{new}'", kind=t.CodeActionKind.QuickFix,
-                    diagnostics=[_diagnostic(d, document)], is_preferred=True,
-                    edit=t.WorkspaceEdit(changes={uri: [edit]})))
+        out += [t.CodeAction(title=d.fix.title, kind=t.CodeActionKind.QuickFix,
+                             diagnostics=[_diagnostic(d, document)], is_preferred=True,
+                             edit=_edit(uri, document, d.fix))
+                for d in seen.diagnostics if d.fix is not None and _touches(d.span, *wanted)]
     if _wanted(params.context.only, ADD_TARGET):
-        out += _add_target(uri, seen)
+        out += _add_target(uri, seen, document)
     return out
+
+
+def _edit(uri: str, document: Document, fix: Fix) -> t.WorkspaceEdit:
+    return t.WorkspaceEdit(changes={uri: [t.TextEdit(range=document.range_of(fix.span),
+                                                     new_text=fix.replacement)]})
 
 
 def _wanted(only: list[str] | None, kind: str) -> bool:
@@ -587,34 +586,16 @@ def _touches(span: Span, start: tuple[int, int], end: tuple[int, int]) -> bool:
     return not (span_end < start or (span.line, span.column) > end)
 
 
-def _add_target(uri: str, seen: Seen) -> list[t.CodeAction]:
-    """`target C-863` / `target C-663` after the leading comments, when the file has none.
-    No rule reports a missing target (the model checks just wait for one), so it is a
-    source action, not a quick fix offered on every line."""
-    source = seen.compilation.source
-    if symbols.has_target(seen.items, source.text):
-        return []
-    at = t.Position(symbols.target_line(source.text), 0)  # column 0: the same in every unit
-    found = LINE_END.search(source.text)
-    end = found.group() if found else "\n"  # the file's own line end, as an editor would
-    return [t.CodeAction(title=f"Add `target {model}`", kind=ADD_TARGET,
-                         edit=t.WorkspaceEdit(changes={uri: [t.TextEdit(
-                             range=t.Range(at, at), new_text=f"target {model}{end}")]}))
-            for model in ("C-863", "C-663")]
+def _add_target(uri: str, seen: Seen, document: Document) -> list[t.CodeAction]:
+    """`target C-863` / `target C-663` after the leading comments, when the file has none
+    (mercmac.compiler.fixing.target_fix). No rule reports a missing target (the model
+    checks just wait for one), so it is a source action, not a quick fix on every line."""
+    from mercmac.compiler.fixing import target_fix
 
-
-def _replacement(d, source: Source, document: Document) -> tuple[t.TextEdit, str] | None:
-    """The edit a "did you mean" message proposes: its first quoted name, replaced."""
-    new = symbols.suggestion(d.message)
-    old = _QUOTED.search(d.message)
-    if new is None or old is None or d.span.end_line not in (0, d.span.line):
-        return None
-    line = source.line(d.span.line)
-    start = line.find(old.group(1), d.span.column - 1, d.span.end_column - 1)
-    if start < 0:
-        return None
-    span = Span(d.span.line, start + 1, d.span.line, start + 1 + len(old.group(1)))
-    return t.TextEdit(range=document.range_of(span), new_text=new), new
+    text = seen.compilation.source.text
+    fixes = [target_fix(text, model) for model in ("C-863", "C-663")]
+    return [t.CodeAction(title=fix.title, kind=ADD_TARGET, edit=_edit(uri, document, fix))
+            for fix in fixes if fix is not None]
 
 
 def main(say: Callable[[str], None]) -> None:

@@ -15,7 +15,7 @@ import reprlib
 from mercmac import suppress
 from mercmac.commands import MODELS
 from mercmac.compiler import checking
-from mercmac.errors import UsageError
+from mercmac.errors import SettingsError
 
 SECTION = "mercmac"
 
@@ -33,26 +33,26 @@ def options_from(section) -> tuple[checking.Options, list[str]]:
             continue
         try:
             kept[key] = _read(key, value)
-        except UsageError as e:
+        except SettingsError as e:
             problems.append(f"{e.message} ({e.hint})" if e.hint else e.message)
     return checking.Options(**kept), problems
 
 
 def _read(key: str, value):
-    """One setting as Options holds it; a UsageError names the setting."""
+    """One setting as Options holds it; a SettingsError names the setting."""
     name = f"{SECTION}.{key}"
     if key == "target":
         if not isinstance(value, str) or value.upper() not in MODELS:
-            raise UsageError(f"{name} = {reprlib.repr(value)} is not a model: use "
-                             f"{' or '.join(MODELS)} (or null)")
+            raise SettingsError(f"{name} = {reprlib.repr(value)} is not a model: use "
+                                f"{' or '.join(MODELS)} (or null)")
         return value.upper()
     if isinstance(value, str):  # one rule, or several comma-separated, as `--select` takes
         value = [value]
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
         bad = next((v for v in value if not isinstance(v, str)), value) \
             if isinstance(value, list) else value
-        raise UsageError(f"{name} must be a list of rule codes or names (strings), e.g. "
-                         f'["MM011", "undefined-macro"]; found {_kind(bad)}')
+        raise SettingsError(f"{name} must be a list of rule codes or names (strings), e.g. "
+                            f'["MM011", "undefined-macro"]; found {_kind(bad)}')
     read = suppress.selection if key == "select" else suppress.rule_set
     return read(value, name)
 

@@ -14,13 +14,16 @@ from typing import NamedTuple
 
 from mercmac.commands import COMMANDS, Mnemonic, lookup
 from mercmac.compiler import ast
+from mercmac.compiler.checks import name_span
 from mercmac.compiler.parse import KEYWORDS  # noqa: F401  (completion and rename use them)
-from mercmac.compiler.program import Origin, Program, wait_pieces
+from mercmac.compiler.program import Program, wait_pieces
+from mercmac.mdtext import slot_name
+from mercmac.ops import Origin
 from mercmac.render.commands import KEYWORD_HELP  # noqa: F401  (hover and completion)
-from mercmac.source import Source, Span, split_lines
+from mercmac.source import Source, Span
+from mercmac.timespec import format_span
 
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.]*\Z")
-_TARGET = re.compile(r"[ \t]*target\b")
 _DEFINES = {ast.MacroDef: re.compile(r"macro\s+([A-Za-z_][A-Za-z0-9_.]*)"),
             ast.Const: re.compile(r"const\s+([A-Za-z_][A-Za-z0-9_.]*)")}
 
@@ -59,7 +62,7 @@ def uses(items: tuple, source: Source, program: Program | None = None) -> list[U
 
 
 def _slot(number: int, span: Span, defines: bool) -> Use:
-    return Use("slot", f"MC{number:02d}", span, defines, number)
+    return Use("slot", slot_name(number), span, defines, number)
 
 
 def _named_slots(items: tuple, program: Program | None) -> dict[str, int]:
@@ -80,9 +83,7 @@ def same(found: list[Use], use: Use) -> list[Use]:
 def _walk(body: tuple, found: list[Use]) -> None:
     for s in body:
         if isinstance(s, (ast.Call, ast.Goto)):
-            end = s.span.end_column
-            found.append(Use("macro", s.name, Span(s.span.end_line, end - len(s.name),
-                                                   s.span.end_line, end), False))
+            found.append(Use("macro", s.name, name_span(s), False))
         elif isinstance(s, ast.Command):
             if s.word.upper() == Mnemonic.EM and isinstance(s.value, ast.Number):
                 found.append(_slot(s.value.value, s.span, False))
@@ -152,7 +153,7 @@ def macro_help(name: str, program: Program | None) -> str:
     if not mine:
         return lines[0] + "\n\n(no slot: not defined)"
     lines += ["", f"slot{'s' if len(mine) > 1 else ''}: "
-              + ", ".join(f"MC{m.slot:02d}" for m in mine), "", "```", *(m.md for m in mine), "```",
+              + ", ".join(slot_name(m.slot) for m in mine), "", "```", *(m.md for m in mine), "```",
               "", _called_by(mine[0].slot, program)]
     return "\n".join(lines)
 
@@ -162,7 +163,7 @@ _UNLOWERED = "\n\n(not lowered: the file has syntax errors)"
 
 def slot_help(slot: int, program: Program | None) -> str:
     """Hover text of a slot (`[MCnn]`, `EMn`): what it holds after lowering, who calls it."""
-    head = f"**MC{slot:02d}**"
+    head = f"**{slot_name(slot)}**"
     if program is None:
         return head + _UNLOWERED
     macro = program.macros.get(slot)
@@ -199,7 +200,7 @@ def duration_help(written: str, ms: int) -> str:
     elif ms <= 1000:
         rate = "polls once a second" if ms == 1000 else f"polls {1000 / ms:.3g} times a second"
     else:
-        rate = f"polls once every {ms / 1000:g} s"
+        rate = f"polls once every {format_span(ms * 1000, digits=None)}"
     return (f"**{written}** = {ms:,} ms = `{waits}`; every {written} {rate} (plus one "
             "controller cycle for each command it runs, 1 ms by default)")
 
@@ -275,26 +276,3 @@ def mnemonics() -> list[tuple[str, str, str]]:
     """(mnemonic, argument hint, summary) of every command a macro may hold (MS176E §3.8)."""
     return [(c.mnemonic, c.expects(), c.summary) for c in COMMANDS.values() if c.storable]
 
-
-_GUESS = re.compile(r"did you mean '?([A-Za-z_][A-Za-z0-9_.?]*)'?\?")
-
-
-def suggestion(message: str) -> str | None:
-    """The replacement a "did you mean" message proposes."""
-    m = _GUESS.search(message)
-    return m.group(1) if m else None
-
-
-def has_target(items: tuple, text: str) -> bool:
-    if any(isinstance(i, ast.Target) for i in items):
-        return True
-    return any(_TARGET.match(line) for line in split_lines(text))
-
-
-def target_line(text: str) -> int:
-    """The 0-based line where a `target` line goes: after the leading comments and blank lines."""
-    lines = split_lines(text)
-    n = 0
-    while n < len(lines) and (not lines[n].strip() or lines[n].lstrip().startswith("//")):
-        n += 1
-    return n

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from mercmac import diagnostics
 from mercmac.diagnostics import Rule
-from mercmac.errors import UsageError
+from mercmac.errors import InputError
 from mercmac.render.console import Line, write_lines
 from mercmac.render.report import printable
 from mercmac.vm import hazards
@@ -59,12 +59,12 @@ def _command_lines(command) -> list[Line]:
 
 
 def _guess_lines(key: str) -> list[Line]:
-    """What to write for a word that is no command (`LED`); UsageError for any other word."""
+    """What to write for a word that is no command (`LED`); InputError for any other word."""
     from mercmac.compiler import guesses
 
     said = guesses.hint(key)
     if said is None:
-        raise UsageError(f"no rule or command '{printable(key)}'", hint=_nearest(key))
+        raise InputError(f"no rule or command '{printable(key)}'", hint=_nearest(key))
     section = guesses.guess(key).section
     return [[(key, "bold"), (": no command or keyword; ", ""), (said, "")]] + \
         ([[(f"({section})", "dim")]] if section else [])

@@ -4,6 +4,8 @@ from __future__ import annotations
 import time
 from typing import TextIO
 
+from mercmac.timespec import format_clock
+
 DELAY_S = 1.0  # issue 11: only runs that take more than a second show progress
 EVERY_S = 0.2  # redraw at most this often
 
@@ -24,7 +26,7 @@ class ProgressLine:
         rate = now_ms / 1000 / (wall - self.start)
         share = now_ms / self.until_ms if self.until_ms else 1
         # \r and ESC [K (erase to end of line): the line is redrawn where it stands
-        self.stream.write(f"\r\x1b[Ksimulating: {_duration(now_ms)} of {_duration(self.until_ms)} "
+        self.stream.write(f"\r\x1b[Ksimulating: {_clock(now_ms)} of {_clock(self.until_ms)} "
                           f"({share:.0%}), {rate:,.0f} simulated s per s")
         self.stream.flush()
         self.shown = True
@@ -35,11 +37,6 @@ class ProgressLine:
             self.stream.flush()
 
 
-def _duration(ms: float) -> str:
-    """'1500d 00:00:00', '12:34:56', '3.2 s'."""
-    s = ms / 1000
-    if s < 60:
-        return f"{s:.1f} s"
-    days, rest = divmod(int(s), 86_400)
-    clock = f"{rest // 3600:02d}:{rest % 3600 // 60:02d}:{rest % 60:02d}"
-    return f"{days}d {clock}" if days else clock
+def _clock(ms: float) -> str:
+    """'1500d 00:00:00': whole seconds in a field of steady width, the line is redrawn."""
+    return format_clock(ms * 1000, places=0, fixed=True)

@@ -6,12 +6,14 @@ import math
 from itertools import islice
 from typing import IO, Iterator
 
-from mercmac.commands import Mnemonic
+from mercmac.mdtext import slot_name
 from mercmac.render.console import Line, write_lines
+from mercmac.timespec import format_clock, format_span
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
+from mercmac.vm.motion import Ended
 from mercmac.sim import record
-from mercmac.sim.record import Folded, Recorder
+from mercmac.sim.record import Fold, Folded, Recorder
 from mercmac.sim.simulate import Run
 
 ON, OFF = "●", "○"
@@ -25,33 +27,8 @@ def ms(t_us: float) -> int | float:
 
 
 def clock(t_us: float) -> str:
-    """'12.345 s' below 1000 s, else '3d 04:05:06.789'."""
-    if t_us == math.inf:
-        return "never"
-    seconds = t_us / 1e6
-    if seconds < 1000:
-        return f"{seconds:.3f} s"
-    days, rest = divmod(seconds, 86400)
-    hours, rest = divmod(rest, 3600)
-    minutes, secs = divmod(rest, 60)
-    text = f"{int(hours):02d}:{int(minutes):02d}:{secs:06.3f}"
-    return f"{int(days)}d {text}" if days else text
-
-
-UNITS = ((86_400e6, "d"), (3_600e6, "h"), (60e6, "min"), (1e6, "s"), (1e3, "ms"))
-
-
-def duration(t_us: float) -> str:
-    """A span for people, 3 significant digits: '39 ms', '1.5 s', '31.7 min', '4.2 d'."""
-    if t_us == math.inf:
-        return "forever"
-    for i, (size, unit) in enumerate(UNITS):
-        value = float(f"{t_us / size:.3g}")
-        if value >= 1 or unit == "ms":
-            if i and value >= UNITS[i - 1][0] / size:  # 59.99 s rounds to 60 s: 1 min
-                return duration(UNITS[i - 1][0])
-            return f"{t_us / size:,.0f} {unit}" if value >= 1000 else f"{value:g} {unit}"
-    return f"{t_us / 1e3:g} ms"  # unreachable: ms catches every span
+    """A time in the timeline: always to the millisecond, so that the column lines up."""
+    return format_clock(t_us, places=3)
 
 
 def plural(n: int, noun: str, nouns: str | None = None) -> str:
@@ -85,9 +62,10 @@ def event_line(event) -> Line | None:
         case ev.MoveStarted(t, kind, target, arrival, segments, where):
             return _at(t) + [(_move(t, kind, target, arrival, segments), "green"),
                              (_where(where), "dim")]
-        case ev.MoveEnded(t, how, position):
-            text = "on target at" if how == "arrived" else "stopped by the limit switch at"
-            return _at(t) + [(f"{text} {position}", "green" if how == "arrived" else "bold red")]
+        case ev.MoveEnded(t, Ended.ARRIVED, position):
+            return _at(t) + [(f"on target at {position}", "green")]
+        case ev.MoveEnded(t, Ended.LIMIT, position):
+            return _at(t) + [(f"stopped by the limit switch at {position}", "bold red")]
         case ev.HomeDefined(t, position, where):
             return _at(t) + [(f"home defined: position is now {position}", "green"), (_where(where), "dim")]
         case ev.ProgramEnded(t):
@@ -96,20 +74,20 @@ def event_line(event) -> Line | None:
             kind = ("identical pass", "identical passes") if not shift else ("pass", "passes")
             moved = f", each {shift:+,} counts further" if shift else ""
             return _at(t) + [(f"fast-forward {plural(passes, *kind)} of {loop.label} "
-                              f"({duration(period)}{_emitted(shape)} each{moved}) "
+                              f"({format_span(period)}{_emitted(shape)} each{moved}) "
                               f"to {clock(t_to)}", "magenta"), (_where(loop), "dim")]
         case Folded():
             return _folded(event)
     return None
 
 
-def _move(t: int, kind: str, target: int, arrival: float, segments: tuple) -> str:
+def _move(t: int, kind: ev.Motion, target: int, arrival: float, segments: tuple) -> str:
     """'move to -2000 from 0 (arrives 0.264 s, in 141 ms)'."""
     if arrival <= t:
         return f"{kind} to {target} (no motion)"
     start = f" from {round(segments[0].x0)}" if segments else ""
     when = "never arrives" if arrival == math.inf else \
-        f"arrives {clock(arrival)}, in {duration(arrival - t)}"
+        f"arrives {clock(arrival)}, in {format_span(arrival - t)}"
     return f"{kind} to {target}{start} ({when})"
 
 
@@ -122,20 +100,32 @@ def _emitted(shape: tuple) -> str:
 
 
 def _flow_text(fold: Folded, entering: bool) -> str:
+    """'enter MC05 (host)', 'MC05 exits on XN1, back to main (MC01)'."""
     e = fold.event
-    if entering:
-        via = getattr(e, "via", Mnemonic.EM)
-        return f"enter {e.label}" + (f" ({via})" if via != Mnemonic.EM else "")
+    if entering:  # a poll's fold holds its exit, and a poll was entered by EM
+        via = e.via if isinstance(e, ev.MacroEntered) else ev.Via.EM
+        return f"enter {e.label}" if via is ev.Via.EM else f"enter {e.label} ({via})"
     back = f", back to {e.back_to}" if e.back_to else ""
-    why = "ends" if e.why == "end" else e.why if e.why == "stopped" else f"exits on {e.why}"
+    match e.why:
+        case ev.Exit.END:
+            why = "ends"
+        case ev.Exit.STOPPED:
+            why = "stopped"
+        case failed:  # an XN or XF
+            why = f"exits on {failed}"
     return f"{e.label} {why}{back}"
 
 
 def _mode_text(fold: Folded) -> str:
     e = fold.event
-    if fold.kind == record.START:
-        return f"{e.via}: {e.label} starts"
-    return f"goto {e.label}" if fold.kind == record.GOTO else f"enter the loop {e.label}"
+    match fold.kind:
+        case Fold.START:
+            return f"{e.via}: {e.label} starts"
+        case Fold.GOTO:
+            return f"goto {e.label}"
+        case Fold.LOOP:
+            return f"enter the loop {e.label}"
+    raise ValueError(f"{fold.kind} is not a mode change")
 
 
 def _folded(fold: Folded) -> Line:
@@ -143,28 +133,32 @@ def _folded(fold: Folded) -> Line:
     return _fold_lines(fold, 2)[0][1]
 
 
-def _shown(kind: str, level: int) -> int:
+def _shown(kind: Fold, level: int) -> int:
     """Lines a fold of a kind makes at a verbosity: a mode change always, an entry or exit
     from `-v` on, a poll (its entry and its exit) only at `-vv` (`-v` sums them up)."""
-    if kind in record.MODES:
-        return 1
-    if kind == record.POLL:
-        return 2 if level >= 2 else 0
-    return 1 if level >= 1 else 0
+    match kind:
+        case Fold.START | Fold.GOTO | Fold.LOOP:
+            return 1
+        case Fold.POLL:
+            return 2 if level >= 2 else 0
+        case Fold.ENTRY | Fold.LEFT:
+            return 1 if level >= 1 else 0
+    raise ValueError(f"no fold of kind {kind}")
 
 
 def _fold_lines(fold: Folded, level: int) -> list[tuple[int, Line]]:
     """(time, line) for a fold at a verbosity; a repeated one is dated at its last time."""
     if not _shown(fold.kind, level):
         return []
-    if fold.kind in record.MODES:
-        texts, style = [_mode_text(fold)], "bold blue"
-    elif fold.kind == record.POLL:
-        texts, style = [_flow_text(fold, True), _flow_text(fold, False)], "blue"
-    else:
-        texts, style = [_flow_text(fold, fold.kind == record.ENTRY)], "blue"
+    match fold.kind:
+        case Fold.START | Fold.GOTO | Fold.LOOP:
+            texts, style = [_mode_text(fold)], "bold blue"
+        case Fold.POLL:
+            texts, style = [_flow_text(fold, True), _flow_text(fold, False)], "blue"
+        case kind:
+            texts, style = [_flow_text(fold, kind is Fold.ENTRY)], "blue"
     if fold.count == 1:
-        times = [fold.first_t, fold.last_t] if fold.kind == record.POLL else [fold.last_t]
+        times = [fold.first_t, fold.last_t] if fold.kind is Fold.POLL else [fold.last_t]
         return [(t, _at(t) + [(text, style)]) for t, text in zip(times, texts)]
     counts = [f"  x{fold.count:,} since {clock(fold.first_t)}", f"  x{fold.count:,}"]
     return [(fold.last_t, _at(fold.last_t) + [(text + count, style)])
@@ -173,11 +167,11 @@ def _fold_lines(fold: Folded, level: int) -> list[tuple[int, Line]]:
 
 def _polls(folds: list[Folded]) -> list[tuple[int, Line]]:
     """`-v`: one line for the polls of a stretch (macros entered only to test a button)."""
-    polls = [f for f in folds if f.kind == record.POLL]
+    polls = [f for f in folds if f.kind is Fold.POLL]
     if not polls:
         return []
     t = max(f.last_t for f in polls)
-    slots = ", ".join(dict.fromkeys(f"MC{f.event.slot:02d}" for f in polls))
+    slots = ", ".join(dict.fromkeys(slot_name(f.event.slot) for f in polls))
     text = (f"{plural(sum(f.count for f in polls), 'poll')} since "
             f"{clock(min(f.first_t for f in polls))}: {slots} tested and left")
     return [(t, _at(t) + [(text, "dim blue")])]
@@ -228,9 +222,8 @@ def timeline(rec: Recorder, level: int = 0) -> list[Line]:
 
 def _unlisted(rec: Recorder, level: int) -> int:
     """The lines the entries past the recorder's cap would make at a verbosity."""
-    folds = sum(n * _shown(kind, level) for kind, n in rec.unlisted.items()
-                if kind not in (record.EVENT, record.POLLED))
-    return rec.unlisted[record.EVENT] + folds + (rec.unlisted[record.POLLED] if level == 1 else 0)
+    folds = sum(n * _shown(kind, level) for kind, n in rec.unlisted.items())
+    return rec.unlisted_events + folds + (rec.unlisted_polled if level == 1 else 0)
 
 
 def _left_out(hidden: int, after_us: int, cut: bool, rec: Recorder) -> Line:
@@ -291,10 +284,8 @@ def write_text(run: Run, stream: IO[str] | None = None, *, with_trace: bool = Fa
 
 def header(run: Run) -> Line:
     """What was simulated, and for how long, with the unit: `--until 3` is 3 ms, not 3 s."""
-    from mercmac.timespec import format_duration
-
-    return [(f"Simulating a {run.machine.model} from power-on until {format_duration(run.until_ms)}",
-             "bold")]
+    until = format_span(run.until_ms * 1000, digits=None)
+    return [(f"Simulating a {run.machine.model} from power-on until {until}", "bold")]
 
 
 def write_vcd_cut(path: str, limit_mb: float, cut_at: int, stream: IO[str] | None = None) -> None:
@@ -366,8 +357,10 @@ def _event_json(event) -> dict:
         case ev.MoveStarted(_, kind, target, arrival, _, where):
             return {"kind": "move", **_source(where), "motion": kind, "target": target,
                     "arrival_ms": None if arrival == math.inf else ms(arrival)}
-        case ev.MoveEnded(_, how, position):
-            return {"kind": "arrive" if how == "arrived" else "limit", "position": position}
+        case ev.MoveEnded(_, Ended.ARRIVED, position):
+            return {"kind": "arrive", "position": position}
+        case ev.MoveEnded(_, Ended.LIMIT, position):
+            return {"kind": "limit", "position": position}
         case ev.HomeDefined(_, position, where):
             return {"kind": "home", **_source(where), "position": position}
         case ev.MacroEntered(_, slot, label, via):
@@ -396,8 +389,8 @@ def live_status(t_us: float, pattern: int, inputs: list[bool], position: int, ta
 def countdown_status(left_s: float, inputs: list[bool]) -> str:
     """The status line before power-on in `sim --interactive`: which inputs will be held."""
     held = " ".join(f"[{n}]" for n in range(1, 7) if inputs[n]) or "none"
-    return (f"power-on in {left_s:.1f} s: keys 1-6 choose the buttons held at power-on, "
-            f"Enter powers on now - held: {held}")
+    return (f"power-on in {format_clock(left_s * 1e6, places=1)}: keys 1-6 choose the buttons "
+            f"held at power-on, Enter powers on now - held: {held}")
 
 
 def reset_line(t_us: float) -> Line:

@@ -9,8 +9,11 @@ import os
 import sys
 from typing import IO
 
+from mercmac.mdtext import slot_name
 from mercmac.render.console import Line, rich_console, table, use_colour, write_lines
 from mercmac.render.sim import plural
+from mercmac.timespec import format_clock
+from mercmac.upload.flasher import Event, EventKind
 
 _FATE_STYLE = {"written": "bold green", "erased": "bold yellow", "re-written last": "green",
                "unchanged": "dim", "kept (not in file)": "yellow"}
@@ -76,22 +79,27 @@ class FlashProgress:
         start, sent0 = self._started
         return _rate_text(event.sent - sent0, event.size - sent0, now - start)
 
-    def __call__(self, event) -> None:
+    def __call__(self, event: Event) -> None:
         if self._progress is None:
-            if event.kind != "step":
+            if event.kind != EventKind.STEP:  # a log line says what was done, not what begins
                 write_lines([_event_line(event)], self.stream)
             return
-        if event.kind in ("step", "verified"):
-            steps, rate = f"{event.done}/{event.total}", self._rate(event)
-            if self._task is None:
-                self._task = self._progress.add_task(event.text, total=event.size or event.total,
-                                                     steps=steps, rate=rate)
-            self._progress.update(self._task, description=event.text, steps=steps, rate=rate,
-                                  completed=event.sent if event.size else event.done, refresh=True)
-        else:
-            from rich.text import Text
+        match event.kind:
+            case EventKind.STEP | EventKind.VERIFIED:
+                self._advance(event)
+            case _:
+                from rich.text import Text
 
-            self._progress.console.print(Text.assemble(*_event_line(event)))
+                self._progress.console.print(Text.assemble(*_event_line(event)))
+
+    def _advance(self, event: Event) -> None:
+        """The bar moves on: the step, the steps done and the rate."""
+        steps, rate = f"{event.done}/{event.total}", self._rate(event)
+        if self._task is None:
+            self._task = self._progress.add_task(event.text, total=event.size or event.total,
+                                                 steps=steps, rate=rate)
+        self._progress.update(self._task, description=event.text, steps=steps, rate=rate,
+                              completed=event.sent if event.size else event.done, refresh=True)
 
 
 class AddressProgress:
@@ -119,28 +127,31 @@ class AddressProgress:
 
 
 def _rate_text(sent: int, size: int, seconds: float) -> str:
-    """'38 B/s, 0:00:12 left' once some bytes went out; '' before."""
+    """'38 B/s, 00:00:12 left' once some bytes went out; '' before (a line redrawn in place)."""
     if sent <= 0 or seconds <= 0:
         return ""
     rate = sent / seconds
     left = int(round((size - sent) / rate)) if size > sent else 0
-    return f"{rate:,.0f} B/s, {left // 3600}:{left % 3600 // 60:02d}:{left % 60:02d} left"
+    return f"{rate:,.0f} B/s, {format_clock(left * 1e6, places=0, fixed=True)} left"
 
 
-def _event_line(event) -> Line:
-    style = {"retry": "bold yellow", "repair": "bold yellow", "backup": "bold"}.get(event.kind, "")
-    if event.kind == "verified":
-        return [(f"[{event.done}/{event.total}] ", "dim"), (event.text, "")]
-    if event.kind == "backup":
-        return [(f"backup of {plural(event.done, 'stored macro')}: {event.text}", style)]
-    return [(event.text, style)]
+def _event_line(event: Event) -> Line:
+    match event.kind:
+        case EventKind.VERIFIED:
+            return [(f"[{event.done}/{event.total}] ", "dim"), (event.text, "")]
+        case EventKind.BACKUP:
+            return [(f"backup of {plural(event.done, 'stored macro')}: {event.text}", "bold")]
+        case EventKind.RETRY | EventKind.REPAIR:
+            return [(event.text, "bold yellow")]
+        case _:
+            return [(event.text, "")]
 
 
 def flash_summary(result, port: str) -> list[Line]:
     """The slot table and the outcome line."""
     plan = result.plan
     dry = result.dry_run
-    rows = [(f"MC{slot:02d}", _name(plan.names.get(slot), slot),
+    rows = [(slot_name(slot), _name(plan.names.get(slot), slot),
              _WOULD[fate.value] if dry else fate.value) for slot, fate in sorted(plan.fates.items())]
     styles = {(_WOULD[k] if dry else k): v for k, v in _FATE_STYLE.items()}
     lines = table(("slot", "macro", "a flash" if dry else "result"), rows,
@@ -155,7 +166,7 @@ def flash_summary(result, port: str) -> list[Line]:
                        f"`mercmac history` will not list it, nor `pull` give back this source",
                        "")])
     if result.retried or result.repaired:
-        again = ", ".join(f"MC{s:02d}" for s in result.retried + result.repaired)
+        again = ", ".join(slot_name(s) for s in result.retried + result.repaired)
         lines.append([("note: ", "bold yellow"), (f"needed a second write: {again} (check the cable)", "")])
     lines.append([("backup: ", "bold"), (str(result.backup), "")])
     lines += _kept_note(result)
@@ -172,7 +183,7 @@ def _kept_note(result) -> list[Line]:
     extra = result.left_over
     if not extra:
         return []
-    slots = ", ".join(f"MC{s:02d}" for s in extra)
+    slots = ", ".join(slot_name(s) for s in extra)
     kept = _kept(len(extra), result.dry_run)
     if not result.restoring:
         return [[("note: ", "bold yellow"),
@@ -267,7 +278,7 @@ def ports_lines(ports) -> list[Line]:
 
 
 def _name(name: str | None, slot: int) -> str:
-    tag = f"MC{slot:02d}"
+    tag = slot_name(slot)
     if not name or name == tag:
         return "-"
     return name.replace(f" ({tag})", "")

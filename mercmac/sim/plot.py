@@ -8,7 +8,7 @@ readable. The position axis spans where the stage goes; a target far outside
 it (a jog's 9999999, stopped after a moment) is an arrow on the edge with its
 value. A label is drawn only where it fits. PNG, SVG and PDF come from
 matplotlib (the extra `plot`, imported only here and only when drawing); HTML is
-the SVG in a page that zooms and pans (render/plot_html.py).
+the SVG in a page that zooms and pans (plot_html.py).
 """
 from __future__ import annotations
 
@@ -19,13 +19,14 @@ import re
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass, field
 
-from mercmac.errors import UsageError
+from mercmac.errors import InputError
 from mercmac.outfile import replacing, writable_target
+from mercmac.timespec import format_clock, format_span
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
 
 FORMATS = (".png", ".svg", ".pdf", ".html")
-MISSING = "--plot needs the plot extra: pip install 'mercmac[plot]'"
+MISSING = "needs the plot extra: pip install 'mercmac[plot]'"
 COMPRESS_US = 10_000_000  # skipped stretches longer than this (10 s) are drawn compressed
 BAND = 0.06  # a compressed stretch's width, as a share of the time drawn to scale
 CURVE = 16  # points per accelerating profile segment
@@ -42,10 +43,15 @@ LABEL_ROOM = 0.015  # a lane label is tried only where this share of the time ax
 LABEL_PAD = 4  # pixels: a label fits when it is this much narrower than its room
 
 
+class PlotError(InputError):
+    """A picture that cannot be drawn (a kind of file not made here, no matplotlib); the
+    message reads on from the option that asked for it (`--plot`)."""
+
+
 def check_target(path: str) -> None:
     """Refuse before any simulating: an unknown kind of file, a bad path, no matplotlib."""
     if os.path.splitext(path)[1].lower() not in FORMATS:
-        raise UsageError(f"--plot {path}: the file must end in .png, .svg, .pdf or .html")
+        raise PlotError(f"{path}: the file must end in .png, .svg, .pdf or .html")
     writable_target(path)
     _pyplot()
 
@@ -54,7 +60,7 @@ def _pyplot():
     try:
         import matplotlib
     except ImportError:
-        raise UsageError(MISSING) from None
+        raise PlotError(MISSING) from None
     matplotlib.use("Agg")  # files only, never a window
     import matplotlib.pyplot as plt
 
@@ -80,10 +86,9 @@ class Trace:
 
 
 class PlotObserver:
-    """An event listener that keeps a Trace; chain the recorder as `then`, call `close`."""
+    """An event listener that keeps a Trace (the machine's listeners); call `close`."""
 
-    def __init__(self, then=None):
-        self.then = then
+    def __init__(self):
         self.trace = Trace()
         self.segments: tuple = ()
         self.sampled_to = 0.0
@@ -95,8 +100,6 @@ class PlotObserver:
     def on_event(self, event) -> None:
         if self.trace.cut_at is None:
             self._take(event)
-        if self.then:
-            self.then(event)
 
     def _take(self, event) -> None:
         t = getattr(event, "t", None)
@@ -201,12 +204,10 @@ class PlotObserver:
 def _last_pattern(shape: tuple) -> int | None:
     """The output pattern a skipped pass leaves behind, if it changes any."""
     last = None
-    for item in shape:
-        if item[0] == ff.OUTPUTS:
-            last = item[2]  # (OUTPUTS, offset, pattern)
-        elif item[0] in (ff.SKIP, ff.SHIFTED):  # an inner skip, shifted or not
-            inner = _last_pattern(item[4])
-            last = last if inner is None else inner
+    for step in ff.compact(shape, 0, 0, 1):  # one pass: only the patterns matter here
+        match step:
+            case ev.OutputsChanged(_, pattern):
+                last = pattern
     return last
 
 
@@ -297,27 +298,13 @@ def _any_in(times: list, a: float, b: float) -> bool:
 
 
 def duration(seconds: float) -> str:
-    """1.5 -> '1.5 s'; 90061.5 -> '1 d 1:01:01.5'."""
-    if seconds < 60:
-        return f"{round(seconds, 6):g} s"
-    whole, frac = divmod(round(seconds, 3), 1)
-    d, rest = divmod(int(whole), 86400)
-    h, rest = divmod(rest, 3600)
-    m, s = divmod(rest, 60)
-    tail = f"{frac:.3f}".lstrip("0").rstrip("0").rstrip(".") if frac else ""
-    return (f"{d} d " if d else "") + f"{h}:{m:02d}:{s:02d}{tail}"
+    """A tick's label (the axis counts seconds): 1.5 -> '1.5 s'; 90061.5 -> '1 d 1:01:01.5'."""
+    return format_clock(seconds * 1e6)
 
 
 def span(us: float) -> str:
-    """A skipped stretch's length in words: '23 h 59 min', '2 min 5 s', '12.5 s'."""
-    s = us / 1e6
-    for unit, size, sub, subsize in (("d", 86400, "h", 3600), ("h", 3600, "min", 60),
-                                     ("min", 60, "s", 1)):
-        if s >= size:
-            big, rest = divmod(s, size)
-            small = int(rest // subsize)
-            return f"{int(big)} {unit}" + (f" {small} {sub}" if small else "")
-    return f"{round(s, 1):g} s"
+    """A skipped stretch's length in whole units: '23 h 59 min' (not '1 d'), '2 min 5 s'."""
+    return format_span(us, parts=2)
 
 
 def figure(trace: Trace, title: str = ""):
@@ -587,7 +574,7 @@ def write(path: str, trace: Trace, title: str = "") -> None:
     kind = os.path.splitext(path)[1].lower().lstrip(".")
     try:
         if kind == "html":
-            from mercmac.render import plot_html
+            from mercmac.sim import plot_html
 
             svg = io.StringIO()
             fig.savefig(svg, format="svg", metadata={"Date": None})

@@ -18,34 +18,39 @@ from collections import Counter
 from dataclasses import dataclass
 from itertools import islice
 
-from mercmac.commands import Mnemonic
+from mercmac.ops import TextEnum
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
 from mercmac.vm.opcodes import Opcode
 
 CAP = 10_000  # SPEC §5: reports, output changes and events beyond this are counted, not listed
-TIMELINE_CAP = 100_000  # timeline entries listed; the rest are counted in Recorder.unlisted
+TIMELINE_CAP = 100_000  # timeline entries listed; the rest are counted (Recorder.unlisted)
 LONG_LOOP = 1000  # an RP repeating this often or more makes a macro a mode, not a step
 
-ENTRY, POLL, LEFT = "entry", "poll", "left"
-START, GOTO, LOOP = "start", "goto", "loop"  # mode changes: power-on or host, tail EM, long loop
-MODES = (START, GOTO, LOOP)
-EVENT = "event"  # an unlisted entry that is not a fold: one line at every verbosity
-POLLED = "polled"  # a stretch between two events with unlisted polls (one line at `-v`)
+
+class Fold(TextEnum):
+    """What a fold of the timeline is (Folded.kind)."""
+
+    ENTRY = "entry"  # a macro entered
+    POLL = "poll"  # entered and left at its first failed condition
+    LEFT = "left"  # a macro left
+    # mode changes: power-on or host, tail EM (a `goto`), an entry into a long loop
+    START = "start"
+    GOTO = "goto"
+    LOOP = "loop"
 
 
 @dataclass(slots=True)
 class Folded:
     """A macro entered (or left the same way) `count` times from `first_t` to `last_t`.
 
-    kind: ENTRY, a mode change (START, GOTO, LOOP), POLL (entered and left at its
-    first failed condition: `event` is the exit, `first_t` the first entry) or LEFT.
+    A POLL's `event` is the exit, its `first_t` the first entry.
     """
 
     event: ev.MacroEntered | ev.MacroLeft
     count: int
     last_t: int
-    kind: str = ENTRY
+    kind: Fold = Fold.ENTRY
     first_t: int = 0
 
 
@@ -62,7 +67,7 @@ def modes(chunks: dict) -> tuple[set[tuple[int, int]], set[int]]:
 
 
 class Recorder:
-    """Collects events; pass its `on_event` to a Machine."""
+    """Collects events; its `on_event` is one of a Machine's listeners."""
 
     def __init__(self):
         self.reports: list[ev.Reported] = []
@@ -72,7 +77,10 @@ class Recorder:
         self.trace: list[ev.Executed] = []
         self.events: list = []  # every event but Executed, unfolded, for JSON (SPEC §5 `events`)
         self.dropped = {"reports": 0, "outputs": 0, "timeline": 0, "trace": 0, "events": 0}
-        self.unlisted: Counter = Counter()  # timeline entries past TIMELINE_CAP, by kind
+        # past TIMELINE_CAP: folds by kind, other events (one line at every verbosity) and
+        # stretches between two events with polls (one line at `-v`)
+        self.unlisted: Counter[Fold] = Counter()
+        self.unlisted_events = self.unlisted_polled = 0
         self.ended_at: int | None = None
         self._folds: dict[tuple, Folded] = {}
         self._gotos: set[tuple[int, int]] = set()
@@ -130,15 +138,18 @@ class Recorder:
     def _log(self, entry) -> None:
         """Onto the timeline; past its cap counted by kind, since what an entry shows
         depends on the verbosity (a poll is two lines at `-vv`, none by default)."""
-        kind = entry.kind if isinstance(entry, Folded) else EVENT
-        first_poll = kind == POLL and not self._polled
-        self._polled = self._polled or kind == POLL
+        kind = entry.kind if isinstance(entry, Folded) else None
+        first_poll = kind is Fold.POLL and not self._polled
+        self._polled = self._polled or kind is Fold.POLL
         if len(self.timeline) < TIMELINE_CAP:
             self.timeline.append(entry)
             return
         self.dropped["timeline"] += 1
-        self.unlisted[kind] += 1
-        self.unlisted[POLLED] += first_poll
+        if kind is None:
+            self.unlisted_events += 1
+        else:
+            self.unlisted[kind] += 1
+        self.unlisted_polled += first_poll
 
     def _flow(self, event: ev.MacroEntered | ev.MacroLeft) -> None:
         entered, self._entered = self._entered, None
@@ -149,20 +160,20 @@ class Recorder:
             self._entered = self._fold((kind, event.slot, ""), event, kind, event.t)
             return
         self._current = event.back_slot
-        if entered is not None and entered.kind == ENTRY and event.why[:2] in (Mnemonic.XN, Mnemonic.XF):
+        if entered is not None and entered.kind is Fold.ENTRY and event.why.failed:
             self._unfold(entered)
-            self._fold((POLL, event.slot, event.why), event, POLL, entered.last_t)
+            self._fold((Fold.POLL, event.slot, event.why), event, Fold.POLL, entered.last_t)
         else:
-            self._fold((LEFT, event.slot, event.why), event, LEFT, event.t)
+            self._fold((Fold.LEFT, event.slot, event.why), event, Fold.LEFT, event.t)
 
-    def _entry_kind(self, event: ev.MacroEntered) -> str:
-        if event.via != Mnemonic.EM:
-            return START
+    def _entry_kind(self, event: ev.MacroEntered) -> Fold:
+        if event.via is not ev.Via.EM:
+            return Fold.START
         if (self._current, event.slot) in self._gotos:
-            return GOTO
-        return LOOP if event.slot in self._loops else ENTRY
+            return Fold.GOTO
+        return Fold.LOOP if event.slot in self._loops else Fold.ENTRY
 
-    def _fold(self, key: tuple, event, kind: str, first_t: int) -> Folded:
+    def _fold(self, key: tuple, event, kind: Fold, first_t: int) -> Folded:
         fold = self._folds.get(key)
         if fold is None:
             fold = self._folds[key] = Folded(event, 0, event.t, kind, first_t)
@@ -181,4 +192,4 @@ class Recorder:
             self.timeline.pop()
         else:  # past the cap: it was counted, not listed
             self.dropped["timeline"] -= 1
-            self.unlisted[ENTRY] -= 1
+            self.unlisted[Fold.ENTRY] -= 1

@@ -24,13 +24,13 @@ the nearest valid key.
 from __future__ import annotations
 
 import codecs
-import difflib
 import json
 import os
 import stat
 from dataclasses import dataclass
 
 from mercmac.errors import MercmacError
+from mercmac.suggest import suggest
 from mercmac.timespec import TimeSpecError, parse_duration
 from mercmac.vm.machine import Machine
 
@@ -176,10 +176,15 @@ def _refuse_unknown(where: str, raw: dict, valid: tuple[str, ...], use: str) -> 
     if not unknown:
         return
     key = unknown[0]
-    near = difflib.get_close_matches(key.lower(), valid, n=1, cutoff=0.6)
-    hint = f"did you mean {near[0]!r}? " if near else ""
+    near = _nearest(key, valid)
+    hint = f"did you mean {near!r}? " if near else ""
     more = f" (and {len(unknown) - 1} more)" if len(unknown) > 1 else ""
     raise ScenarioError(f"{where}unknown key {_show(key)}{more}: {hint}{use}")
+
+
+def _nearest(word: str, known) -> str | None:
+    """The key or macro name `word` was probably meant to be (two edits for short words)."""
+    return suggest(word, known, max(2, len(word) // 3))
 
 
 def _step(i: int, raw: dict) -> Step:
@@ -266,8 +271,8 @@ def check_names(m: Machine, scenario: Scenario) -> None:
     for expect in scenario.expects:
         want = expect.checks.get("macro")
         if isinstance(want, str) and want != "none" and want not in names:
-            near = difflib.get_close_matches(want, sorted(names), n=1, cutoff=0.6)
-            hint = f"; did you mean {near[0]!r}?" if near else \
+            near = _nearest(want, names)
+            hint = f"; did you mean {near!r}?" if near else \
                 f"; it has {', '.join(sorted(names)) or 'no named macros'}"
             raise ScenarioError(f"{scenario.name}: expect {expect.number}: macro = {_show(want)}: "
                                 f"the program has no macro of that name{hint}")

@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import IO, Iterable
+from typing import IO, Iterable, Sequence
 
 from mercmac.compiler.program import Program
 from mercmac.timespec import Press
-from mercmac.vm.machine import Machine
+from mercmac.vm.machine import Listener, Machine
 from mercmac.vm.models import Options
 from mercmac.sim.record import Recorder
 
@@ -46,15 +46,17 @@ def schedule(machine: Machine, presses: Iterable[Press]) -> None:
 
 def machine_for(program: Program, *, model: str | None = None, cycle_ms: float = 1.0,
                 options: Options | None = None, trace: bool = False,
-                fast_forward: str = "all") -> tuple[Machine, Recorder]:
-    """A machine with a recorder attached, not yet powered on.
+                fast_forward: str = "all",
+                listeners: Sequence[Listener] = ()) -> tuple[Machine, Recorder]:
+    """A machine with a recorder listening after `listeners`, not yet powered on.
 
     The recorder counts what skipped passes emitted, so every repeating pass may
     be skipped (fast_forward "all"); "off" steps every pass (for comparisons).
     """
     record = Recorder()
     machine = Machine(program, model=model, cycle_ms=cycle_ms, options=options,
-                      on_event=record.on_event, trace=trace, fast_forward=fast_forward)
+                      listeners=[*listeners, record.on_event], trace=trace,
+                      fast_forward=fast_forward)
     record.know(machine.chunks)
     return machine, record
 
@@ -66,20 +68,18 @@ def simulate(program: Program, *, presses: Iterable[Press] = (), until_ms: int =
     """Power on at t = 0 (macro 0 starts, SPEC §3 Power-on) and run to until_ms.
 
     A VCD stops (a valid file) before it would pass `vcd_limit` bytes; the run goes on.
-    `watch` is one more listener (a plot) with `on_event` and `then`; it sees every event first.
+    `watch` is one more listener (a plot) with `on_event`; it hears every event first.
     `progress` (`update(now_ms)`, `close()`) hears the simulated time reached as the run goes.
     Ctrl-C (KeyboardInterrupt) ends the run where it is: the Run is marked `interrupted`.
     """
-    machine, record = machine_for(program, model=model, cycle_ms=cycle_ms, options=options,
-                                  trace=trace)
     dump = None
     if vcd is not None:
         from mercmac.sim.vcd import VcdObserver
 
-        dump = VcdObserver(vcd, record.on_event, vcd_limit)
-        machine.on_event = dump.on_event
-    if watch is not None:
-        watch.then, machine.on_event = machine.on_event, watch.on_event
+        dump = VcdObserver(vcd, vcd_limit)
+    listeners = [listener.on_event for listener in (watch, dump) if listener is not None]
+    machine, record = machine_for(program, model=model, cycle_ms=cycle_ms, options=options,
+                                  trace=trace, listeners=listeners)
     schedule(machine, presses)
     machine.power_on()
     interrupted = False

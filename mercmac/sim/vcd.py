@@ -37,8 +37,7 @@ class _Counted:
 class VcdObserver:
     """An event listener that writes value changes; call `close(t_us)` at the end."""
 
-    def __init__(self, stream: IO[str], then=None, limit: int | None = None):
-        self.then = then  # the next listener (the recorder)
+    def __init__(self, stream: IO[str], limit: int | None = None):
         self.out = _Counted(stream)
         self.limit = limit
         self.cut_at: int | None = None  # us: where the dump stopped at the size limit
@@ -62,8 +61,6 @@ class VcdObserver:
             if self.cut_at is None:
                 self._change(event, t)
                 self._check_size(self.last)
-        if self.then:
-            self.then(event)
 
     def _full(self) -> bool:
         return self.limit is not None and self.out.written + CLOSING > self.limit
@@ -80,8 +77,7 @@ class VcdObserver:
             case ev.InputChanged(_, n, on):
                 w.change(self.inputs[n], t, int(on))
             case ev.OutputsChanged(_, pattern):
-                for i, var in enumerate(self.outputs):
-                    w.change(var, t, pattern >> i & 1)
+                self._outputs(t, pattern)
             case ev.MacroEntered(_, slot):
                 w.change(self.macro, t, slot)
             case ev.MacroLeft(back_slot=back):
@@ -95,20 +91,22 @@ class VcdObserver:
             case ev.FastForwarded(_, _, passes, period, _, shape):
                 self._stretch(t, passes, period, shape)
 
+    def _outputs(self, t: int, pattern: int) -> None:
+        for i, var in enumerate(self.outputs):
+            self.writer.change(var, t, pattern >> i & 1)
+
     def _stretch(self, t: int, passes: int, period: int, shape: tuple) -> None:
         """Skipped passes: marked, all but the last left out; the last one dumped."""
-        last = t + (passes - 1) * period
-        if passes > 1:
-            self.writer.change(self.skipping, t, 1)
-            self.writer.change(self.skipping, last, 0)
-        self.last = last
-        for item in shape:
-            if item[0] == ff.OUTPUTS:
-                self.last = last + item[1]
-                for i, var in enumerate(self.outputs):
-                    self.writer.change(var, self.last, item[2] >> i & 1)
-            elif item[0] in (ff.SKIP, ff.SHIFTED):  # an inner skip, shifted or not
-                self._stretch(last + item[1], item[2], item[3], item[4])
+        for step in ff.compact(shape, t, period, passes):
+            match step:
+                case ff.Stretch(start, last, n):
+                    if n > 1:
+                        self.writer.change(self.skipping, start, 1)
+                        self.writer.change(self.skipping, last, 0)
+                    self.last = last
+                case ev.OutputsChanged(at, pattern):
+                    self.last = at
+                    self._outputs(at, pattern)
 
     def _sample(self, until: int) -> None:
         """Position samples of the running profile up to `until`."""

@@ -11,6 +11,7 @@ import re
 from pathlib import Path
 
 from mercmac import __version__, outfile
+from mercmac.mdtext import slot_name
 from mercmac.upload.protocol import Version
 
 
@@ -35,7 +36,7 @@ def to_mcm(macros: dict[int, str], version: Version, *, port: str, address: int,
         f"target {version.model}" if version.model else "// no `target`: VE names no known model",
         "",
     ]
-    body = [f"[MC{slot:02d}] {text}" for slot, text in sorted(macros.items())]
+    body = [f"[{slot_name(slot)}] {text}" for slot, text in sorted(macros.items())]
     return "\n".join(head + body) + "\n"
 
 

@@ -1,17 +1,23 @@
-"""The uploader's errors as people read them: the top layer rewords everything into these."""
+"""The uploader's errors as people read them: the top layer rewords everything into these.
+
+Each is also of one of the library's kinds (mercmac.errors), which sets its exit code.
+"""
 from __future__ import annotations
 
-from mercmac.errors import EXIT_INTERRUPTED, EXIT_USAGE, MercmacError
+from mercmac.errors import InputError, Interrupted, MercmacError
 
 
 class UploadError(MercmacError):
     """A flash, pull or scan that could not be done; exit code 1."""
 
 
-class PortError(UploadError):
+class PortError(UploadError, InputError):
     """The port cannot be opened (missing, busy, no permission); exit code 2 like other I/O."""
 
-    exit_code = EXIT_USAGE
+
+class NotChosen(UploadError, InputError):
+    """No port or address given, and none stands out: the message lists the candidates
+    (exit code 2, as for any option that must be given)."""
 
 
 class Refused(UploadError):
@@ -22,7 +28,5 @@ class FlashFailed(UploadError):
     """Stopped after writing began; the message lists what was written and the backup."""
 
 
-class FlashInterrupted(FlashFailed):
+class FlashInterrupted(FlashFailed, Interrupted):
     """Ctrl-C during a flash; exit code 130 like any interrupted command."""
-
-    exit_code = EXIT_INTERRUPTED

@@ -9,13 +9,14 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from enum import Enum
 from pathlib import Path
 from typing import Callable, Iterator
 
 from mercmac.compiler import Compilation, compile_file
 from mercmac.compiler.program import Program
 from mercmac import mdtext
-from mercmac.upload import backup, protocol
+from mercmac.upload import backup, protocol, survey
 from mercmac.upload.controller import Controller, ControllerError, LinkLost
 from mercmac.upload.errors import FlashFailed, FlashInterrupted, Refused
 from mercmac.upload.plan import Action, Plan, Step, make_plan
@@ -25,11 +26,22 @@ from mercmac.upload.transport import DEFAULT_BAUD, Timing
 CLEANUP_TIMEOUT = 0.5  # s: after Ctrl-C, how long one tidy-up read may take
 
 
+class EventKind(str, Enum):
+    """What an Event tells; its words are render.upload's."""
+
+    BACKUP = "backup"  # the controller's macros saved before the first write
+    STEP = "step"  # a step of the plan begins
+    VERIFIED = "verified"  # that step read back right
+    RETRY = "retry"  # it read back wrong and is written once more
+    REPAIR = "repair"  # a garbled line changed another slot, which is restored
+    RESET = "reset"  # RT sent: macro 0 starts
+
+
 @dataclass(frozen=True, slots=True)
 class Event:
     """Something to show while flashing; `done`/`total` drive a progress bar."""
 
-    kind: str  # backup, plan, step, verified, retry, repair, reset
+    kind: EventKind
     text: str  # backup: the backup's path
     done: int = 0  # backup: how many macros it holds
     total: int = 0
@@ -120,7 +132,7 @@ def flash_file(port: str, path: str, *, address: int | None = 0, baud: int = DEF
     A file without `target` (and no `target` given) is compiled again for the model
     that answers, so that it is checked against that controller; a model other than
     the program's is refused unless `force`. `address` None: 0 if anything answers there,
-    else the only address that answers (survey.find_address). Refused, FlashFailed, FlashInterrupted or
+    else the only address that answers (survey.reach). Refused, FlashFailed, FlashInterrupted or
     PortError say what happened; backup.BackupError: `options.backup` cannot be written
     (checked before the port is opened); OSError: the file cannot be read.
     """
@@ -134,11 +146,7 @@ def flash_file(port: str, path: str, *, address: int | None = 0, baud: int = DEF
         backup.check(options.backup)  # a device, FIFO or folder: refused before the port opens
     with open_controller(port, address or 0, baud=baud, timing=timing) as c:
         try:
-            if address is None:
-                from mercmac.upload.survey import find_address
-
-                with watch.searching() as searched:
-                    c.address = find_address(c.transport, searched)
+            survey.reach(c, address, watch.searching)  # as pull_file finds it
             who = identify(c)
             if program.target is None:
                 compiled = _compile(path, who.version.model, watch)
@@ -208,7 +216,7 @@ def flash(controller: Controller, identity: Identity, program: Program,
             return result
         result.backup = _save_backup(controller, identity, stored, options.backup)
         # words are render.upload's: the count of macros backed up, and where
-        notify(Event("backup", str(result.backup), len(stored)))
+        notify(Event(EventKind.BACKUP, str(result.backup), len(stored)))
     except ControllerError as e:
         raise refusal(controller, e) from None
     except KeyboardInterrupt:
@@ -251,12 +259,13 @@ class _Run:
         try:
             for i, step in enumerate(self.plan.steps):
                 self.current = step
-                self.notify(Event("step", step.describe, i, total, sent, size))
+                self.notify(Event(EventKind.STEP, step.describe, i, total, sent, size))
                 self._apply(step)
                 self.done.append(step)
                 self.current = None
                 sent += sizes[i]
-                self.notify(Event("verified", f"{step.describe}: verified", i + 1, total, sent, size))
+                self.notify(Event(EventKind.VERIFIED, f"{step.describe}: verified", i + 1, total,
+                                  sent, size))
         except KeyboardInterrupt:
             kind, cause, alive = FlashInterrupted, "interrupted (Ctrl-C)", True
         except _Mismatch as e:
@@ -287,15 +296,15 @@ class _Run:
                                    f"{self.result.backup}); interrupted while sending RT, so "
                                    f"macro 0 may not have started",
                                    hint="power-cycle the controller to start macro 0") from None
-        self.notify(Event("reset", "RT sent: the controller restarts and runs macro 0"))
+        self.notify(Event(EventKind.RESET, "RT sent: the controller restarts and runs macro 0"))
 
     def _apply(self, step: Step) -> None:
         """Send, read back; on a mismatch repair what a lost character hit and send once more."""
         self._send(step)
         got = self.c.read_slot(step.slot)
         if not protocol.same_macro(got, step.expected):
-            self.notify(Event("retry", f"{step.name} read back wrong "
-                                       f"({protocol.difference(step.expected, got)}); writing it again"))
+            self.notify(Event(EventKind.RETRY, f"{step.name} read back wrong "
+                              f"({protocol.difference(step.expected, got)}); writing it again"))
             self.result.retried.append(step.slot)
             self._reconcile(step.slot)
             self._send(step)
@@ -315,8 +324,9 @@ class _Run:
             if slot == skip or protocol.same_macro(actual.get(slot), want):
                 continue
             fix = Step(Action.WRITE if want else Action.ERASE, slot,
-                       self.plan.names.get(slot, f"MC{slot:02d}"), want)
-            self.notify(Event("repair", f"{fix.name} was changed by a garbled line; restoring it"))
+                       self.plan.names.get(slot, mdtext.slot_name(slot)), want)
+            self.notify(Event(EventKind.REPAIR,
+                              f"{fix.name} was changed by a garbled line; restoring it"))
             self._send(fix)
             got = self.c.read_slot(slot)
             if not protocol.same_macro(got, want):

@@ -93,12 +93,12 @@ def make_plan(program: Program, stored: dict[int, str], *, erase_unused: bool = 
     others = [step for step in others if step]
     steps, changes_zero = [], fates.get(0) in (Fate.WRITTEN, Fate.ERASED)
     if 0 in stored and (changes_zero or others):
-        steps.append(Step(Action.PARK, 0, names.get(0, "MC00")))
+        steps.append(Step(Action.PARK, 0, names.get(0, mdtext.slot_name(0))))
         if fates[0] in (Fate.UNCHANGED, Fate.KEPT):
             fates[0] = Fate.RESTORED
     steps += others
     if 0 in after and (0 not in stored or steps):
-        steps.append(Step(Action.WRITE, 0, names.get(0, "MC00"), after[0]))
+        steps.append(Step(Action.WRITE, 0, names.get(0, mdtext.slot_name(0)), after[0]))
     return Plan(steps, fates, names, dict(stored), after)
 
 
@@ -110,7 +110,7 @@ def _fate(slot: int, wanted: dict[int, str], stored: dict[int, str], erase_unuse
 
 
 def _step(slot: int, fate: Fate, after: dict[int, str], names: dict[int, str]) -> Step | None:
-    name = names.get(slot, f"MC{slot:02d}")
+    name = names.get(slot, mdtext.slot_name(slot))
     if fate is Fate.WRITTEN:
         return Step(Action.WRITE, slot, name, after[slot])
     if fate is Fate.ERASED:

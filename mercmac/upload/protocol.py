@@ -195,21 +195,24 @@ def is_status(report: str) -> bool:
 
 # -- TM / TZ (MS176E §6.4 TM: "MC001 MR55555"; TZ: "MC000 MR5000,WS100,GH")
 
-_MACRO_LINE = re.compile(r"^MC\s*(\d{3}|\d{1,2}(?=\s|$))(?:\s+(.*))?$", re.IGNORECASE)
+def _told(line: str) -> mdtext.Listed | None:
+    """A line of a TM/TZ report as mdtext reads macro listings, or None when it is none."""
+    found = mdtext.listed(line)
+    return found if found is not None and found.form is mdtext.Form.TM else None
 
 
 def parse_macro_line(line: str) -> tuple[int, str]:
     """Slot and contents of one `MCnnn ...` line; a bare `MCnnn` is an empty slot (SPEC §4)."""
-    m = _MACRO_LINE.match(line.strip())
-    if not m or int(m.group(1)) > 31:
+    found = _told(line.strip())
+    if found is None or found.slot > 31:
         raise ProtocolError("not a macro listing (expected 'MCnnn commands', "
                             "MS176E §6.4 TM)", line)
-    return int(m.group(1)), (m.group(2) or "").strip()
+    return found.slot, found.body.strip()
 
 
 def is_macro_report(report: str) -> bool:
     """An empty report or one made only of `MCnnn` lines: an answer to TM/TZ."""
-    return all(_MACRO_LINE.match(line) for line in lines(report))
+    return all(_told(line) for line in lines(report))
 
 
 def parse_macros(report: str) -> dict[int, str]:

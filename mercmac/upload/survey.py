@@ -1,21 +1,24 @@
 """Looking without writing: `pull` a controller's macros, `scan` addresses, list `ports`."""
 from __future__ import annotations
 
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass, replace
 from typing import Callable
 
-from mercmac.errors import UsageError
 from mercmac.upload import backup
 from mercmac.upload.controller import (BadReply, Controller, ControllerError, Flood, LinkLost,
                                        NoAnswer)
-from mercmac.upload.errors import Refused, UploadError
+from mercmac.upload.errors import NotChosen, Refused, UploadError
 from mercmac.upload.protocol import Status, Version
-from mercmac.upload.connect import Identity, identify, refusal
-from mercmac.upload.transport import Transport
+from mercmac.upload.connect import Identity, identify, open_controller, refusal
+from mercmac.upload.transport import DEFAULT_BAUD, Timing, Transport
 
 PI_VENDOR = 0x1A72  # USB vendor id of Physik Instrumente
 PI_PRODUCTS = {0x1007: "C-863"}  # USB product ids known to be Mercury controllers
 SEARCH_TIMEOUT = 0.3  # s: the longest wait at each address when looking for the controller
+
+# Around a search for the controller's address: yields where each address probed is told.
+Searching = Callable[[], AbstractContextManager[Callable[[int], None]]]
 
 
 @dataclass(frozen=True, slots=True)
@@ -25,6 +28,27 @@ class Pulled:
     identity: Identity
     macros: dict[int, str]
     text: str
+
+
+def pull_file(port: str, *, address: int | None = 0, baud: int = DEFAULT_BAUD,
+              timing: Timing = Timing(), searching: Searching | None = None) -> Pulled:
+    """The macros of the controller on PORT, for a .mcm file: at `address`, or with None
+    found as flash_file finds it (`reach`). Reading stops a running macro (MS176E §3.8.3)."""
+    with open_controller(port, address or 0, baud=baud, timing=timing) as c:
+        reach(c, address, searching)
+        return pull(c)
+
+
+def reach(controller: Controller, address: int | None, searching: Searching | None = None) -> None:
+    """Point CONTROLLER at `address`; None: 0 if anything answers there, else the only one of
+    1-15 that answers (find_address), inside `searching()`."""
+    if address is None:
+        with (searching or _unseen)() as probing:
+            controller.address = find_address(controller.transport, probing)
+
+
+def _unseen() -> AbstractContextManager[Callable[[int], None]]:
+    return nullcontext(lambda address: None)
 
 
 def pull(controller: Controller) -> Pulled:
@@ -96,7 +120,7 @@ def find_address(transport: Transport,
     of old, and no search), else the only one of 1-15 that answers `%`.
 
     Addresses 1-15 are probed with at most SEARCH_TIMEOUT each (about 5 s in all).
-    Refused when none answers; UsageError (exit 2) when several do: say which with --address.
+    Refused when none answers; NotChosen (exit 2) when several do: say which with --address.
     """
     at_zero = Controller(transport, 0)
     try:
@@ -124,9 +148,9 @@ def find_address(transport: Transport,
     where = f"on {transport.port}"
     if answering:
         listed = ", ".join(f"{f.address} ({f.model})" for f in answering)
-        raise UsageError(f"no --address given, and {len(answering)} controllers answer {where}: "
-                         f"addresses {listed}; nothing was written",
-                         hint=f"say which one: --address {answering[0].address}")
+        raise NotChosen(f"no --address given, and {len(answering)} controllers answer {where}: "
+                        f"addresses {listed}; nothing was written",
+                        hint=f"say which one: --address {answering[0].address}")
     if found:
         raise Refused(f"no controller answers like a Mercury at addresses 0-15 {where} "
                       f"(garbled replies at {', '.join(str(f.address) for f in found)}); "

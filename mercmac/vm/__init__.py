@@ -1,9 +1,10 @@
 """The simulator core: a bytecode VM of a Mercury controller (SPEC §3).
 
-    Machine(program, model=..., cycle_ms=1.0, options=Options(...), on_report=f)
+    Machine(program, model=..., cycle_ms=1.0, options=Options(...), on_report=f,
+            listeners=[g, ...])  # g(event) hears every vm.events record, in order
     .power_on() .load(p) .define(slot, ops) .execute_line(ops) .start_macro(n) .stop()
     .run_until(t_ms) .set_input(n, on) .running .now_ms .macro .position() .target
-    .velocity() .outputs_pattern() .status() .error
+    .velocity() .outputs_pattern() .status() .snapshot() .error
     for applications (emulator, scenarios, the box): .stored_macros() .setting(name)
     .set_error(code) .take_self_select() .moving() .label .input(n) .input_lines()
     .now_us .cycle_ms; Options(firmware=...) is the version VE reports

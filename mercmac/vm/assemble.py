@@ -5,7 +5,9 @@ from dataclasses import dataclass, field
 from typing import Iterable
 
 from mercmac.commands import C863, COMMANDS
-from mercmac.compiler.program import Macro, Op, Program
+from mercmac.compiler.program import Macro, Program
+from mercmac.mdtext import slot_name
+from mercmac.ops import Op
 from mercmac.source import Span
 from mercmac.vm.opcodes import OPERANDS, Opcode, Operand, opcode_for
 
@@ -21,18 +23,20 @@ class Chunk:
     code: list[tuple[Opcode, object]] = field(default_factory=list)
     texts: list[str] = field(default_factory=list)
     spans: list[Span | None] = field(default_factory=list)
+    # 'main (MC05)', 'MC05', 'direct': named once, as every report and macro entry names it
+    label: str = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        if self.slot == DIRECT:
+            self.label = "direct"
+        else:
+            tag = slot_name(self.slot)
+            self.label = tag if self.name in ("", tag) else f"{self.name} ({tag})"
 
     @property
     def line(self) -> str:
         """The line as the controller stores it (upper case, no spaces): what TM reports."""
         return ",".join(self.texts)
-
-    @property
-    def label(self) -> str:
-        if self.slot == DIRECT:
-            return "direct"
-        tag = f"MC{self.slot:02d}"
-        return tag if self.name in ("", tag) else f"{self.name} ({tag})"
 
 
 def operand(op: Op, opcode: Opcode) -> object:

@@ -1,19 +1,22 @@
 """The controller's clock: integer microseconds and the command cycle (SPEC §3 Time)."""
 from __future__ import annotations
 
-from mercmac.vm import fastforward as ff
+from dataclasses import dataclass
+
+from mercmac.vm.statekey import key, keyed, unkeyed
 
 
 class CycleError(ValueError):
     """A command cycle the clock cannot count in (not finite, or outside 1 us to 1 s)."""
 
 
+@keyed()
+@dataclass(init=False, eq=False)
 class Clock:
     """Now, in us since power-on, and how long one executed command takes."""
 
-    STATE_KEY = ("cycle",)  # fastforward.key_fields
-    NOT_KEYED = {"now": "the clock itself: passes are compared at different times"}
-    state_key = ff.key_fields(*STATE_KEY)
+    cycle: int = key()  # us per executed command
+    now: int = unkeyed("the clock itself: passes are compared at different times")
 
     def __init__(self, cycle_ms: float = 1.0):
         # bounded before rounding: round() fails on nan and inf, and 1e308 ms * 1000 is inf
@@ -27,4 +30,3 @@ class Clock:
     @property
     def now_ms(self) -> float:
         return self.now / 1000
-

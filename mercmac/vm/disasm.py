@@ -1,6 +1,7 @@
 """The disassembler (clox `debug.c`): bytecode back to readable instructions; backs --trace."""
 from __future__ import annotations
 
+from mercmac.mdtext import slot_name
 from mercmac.vm.assemble import Chunk
 from mercmac.vm.opcodes import OPERANDS, Opcode, Operand
 
@@ -14,7 +15,7 @@ def operand_text(opcode: Opcode, operand: object) -> str:
         mnemonic, value = operand
         return mnemonic if value is None else f"{mnemonic} {value}"
     if kind is Operand.SLOT:
-        return f"MC{operand:02d}"
+        return slot_name(operand)
     if kind is Operand.PATTERN:
         return f"{operand:04b}"[::-1].replace("1", "●").replace("0", "○")
     if kind is Operand.INPUT:

@@ -1,9 +1,50 @@
-"""What the machine tells its observer, as plain records; times are microseconds."""
+"""What the machine tells its listeners, as plain records; times are microseconds."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from mercmac.commands import Mnemonic
+from mercmac.ops import TextEnum
 from mercmac.source import Span
+from mercmac.vm.motion import Ended
+
+
+class Motion(TextEnum):
+    """What started a profile (MoveStarted.kind)."""
+
+    MOVE = "move"  # MA, MR, GH
+    HOME_SEARCH = "home search"  # FE
+    STOP = "stop"  # AB1, ST, the joystick released
+    ABORT = "abort"  # AB, MN/MF while moving
+    JOYSTICK = "joystick"  # JN with input 5 ON
+
+
+class Via(TextEnum):
+    """How a macro was entered (MacroEntered.via)."""
+
+    POWER_ON = "power-on"  # macro 0 at power-on or RT (§3.8.5)
+    EM = Mnemonic.EM  # from a macro
+    HOST = "host"  # EMn typed in direct mode
+
+
+class Exit(TextEnum):
+    """Why a macro was left (MacroLeft.why): its end, a stop, or a failed condition."""
+
+    END = "end"
+    STOPPED = "stopped"  # a character from the host (§3.8.3)
+    # XNn: input n was OFF; XFn: input n was ON (§6.4 XN, XF)
+    XN1, XN2, XN3, XN4, XN5, XN6 = "XN1", "XN2", "XN3", "XN4", "XN5", "XN6"
+    XF1, XF2, XF3, XF4, XF5, XF6 = "XF1", "XF2", "XF3", "XF4", "XF5", "XF6"
+
+    @property
+    def failed(self) -> bool:
+        """Whether a condition failed (an XN or XF), rather than the macro ending or stopping."""
+        return self is not Exit.END and self is not Exit.STOPPED
+
+
+# The exit of a failed XNn and XFn by input number n (index 0 unused, as inputs count from 1)
+FAILED_XN = (None, Exit.XN1, Exit.XN2, Exit.XN3, Exit.XN4, Exit.XN5, Exit.XN6)
+FAILED_XF = (None, Exit.XF1, Exit.XF2, Exit.XF3, Exit.XF4, Exit.XF5, Exit.XF6)
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,10 +91,10 @@ class HazardFound:
 
 @dataclass(frozen=True, slots=True)
 class MoveStarted:
-    """A profile started: kind is move, home search, stop, abort or joystick."""
+    """A profile started."""
 
     t: int
-    kind: str
+    kind: Motion
     target: int
     arrival: float  # us; inf when it never arrives
     segments: tuple  # profile.Segment records, for position plots (VCD)
@@ -62,10 +103,10 @@ class MoveStarted:
 
 @dataclass(frozen=True, slots=True)
 class MoveEnded:
-    """The profile ended: 'arrived' on target, or stopped by a hard 'limit'."""
+    """The profile ended: on target, or stopped by a hard limit switch."""
 
     t: int
-    how: str
+    how: Ended
     position: int
 
 
@@ -81,7 +122,7 @@ class MacroEntered:
     t: int
     slot: int
     label: str
-    via: str  # 'power-on', 'EM', 'host'
+    via: Via
 
 
 @dataclass(frozen=True, slots=True)
@@ -89,7 +130,7 @@ class MacroLeft:
     t: int
     slot: int
     label: str
-    why: str  # 'end', 'XN1' (a failed condition), 'stopped'
+    why: Exit
     back_to: str | None  # the label execution returns to, None when the program ends
     back_slot: int | None = None
 
@@ -104,7 +145,7 @@ class FastForwarded:
     """`passes` identical passes of a loop skipped from t to t_to, `period` us each.
 
     `shape` is what each skipped pass emitted (reports, output changes, inner
-    skips) relative to its start; fastforward.count and expand read it.
+    skips: fastforward's items) relative to its start; fastforward.count and expand read it.
     """
 
     t: int

@@ -1,4 +1,5 @@
-"""Fast-forward: skip the identical passes of a polling loop in one step (issue 3, item 5).
+"""Fast-forward: when the passes of a polling loop repeat, and what the skipped ones emit
+(issue 3, item 5). The optimiser (vm/optimiser.py) applies these rules to a running machine.
 
 A loop anchor is an RP jump or the entry of a macro by EM. When a loop comes
 back to its anchor with the whole machine state equal to the last visit (apart
@@ -11,8 +12,8 @@ exactly.
 A pass may also emit reports and output changes (issue 7, item 7: a blinking
 LED, `every 20ms { TT }`): when two passes in a row start from the same state
 and emit the same things at the same offsets (the same `shape`), the later
-passes emit them too, and a skip carries that shape so that its observer can
-count (and list, up to its cap) exactly what plain stepping would have emitted.
+passes emit them too, and a skip carries that shape so that its listeners can
+count (and list, up to their cap) exactly what plain stepping would have emitted.
 Passes that move, report a hazard or see an input change never repeat this way.
 
 Shifted passes (issue 11, item 3: a jog loop with a button held, a scan stepping
@@ -26,27 +27,301 @@ limit switch, the end of the run, an input change, the RP counter's end, and the
 time from which the float sum of a profile's segment lengths could round to
 another arrival microsecond. What a pass does that cannot shift exactly (a
 report or a command while the axis moves, a trigger, a reference search, DH, a
-limit hit) leaves a `Mark` in the effect log and makes the pass unskippable.
+limit hit) leaves `Note.UNSHIFTABLE` in the effect log and makes the pass unskippable.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 from enum import Enum
-from operator import attrgetter
 from fractions import Fraction
 from typing import Iterator, NamedTuple
 
 from mercmac.vm import events as ev
+from mercmac.vm.motion import Ended
 from mercmac.vm.reports import number
 
-REPORT, OUTPUTS, SKIP = "report", "outputs", "skip"  # what a shape's items are
-PLACED, MOVE, ARRIVE, ABSOLUTE = "placed", "move", "arrive", "absolute"  # moved_shape's too
-SHIFTED = "shifted"  # an inner skip that moves or shifts
-REQUESTED, UNSHIFTABLE = "requested", "unshiftable"  # what a Mark notes
-FLOW = (ev.MacroEntered, ev.MacroLeft, ev.Executed)  # control flow: repeats with the pass
+
+# ---------------------------------------------------------------- what a pass emitted
+class Tag(Enum):
+    """What a shape item is. It is each item's first field: shapes are compared as tuples
+    (in C, at every loop anchor), and two items of different kinds must never be equal."""
+
+    REPORT = "report"
+    OUTPUTS = "outputs"
+    SKIP = "skip"  # an inner skip whose passes are the same at any position
+    SHIFTED = "shifted"  # an inner skip that moves or shifts
+    PLACED = "placed"  # a report that shows the position (moved_shape)
+    MOVE = "move"
+    ARRIVE = "arrive"
+    ABSOLUTE = "absolute"  # a TS report: it shows the switches, not a relative position
 
 
+REPORT, OUTPUTS = Tag.REPORT, Tag.OUTPUTS  # what count and expand select
+MOVE = Tag.MOVE  # the tag of a Move laid out as a plain tuple (_same_arrival reads either)
+
+
+class Report(NamedTuple):
+    tag: Tag  # Tag.REPORT
+    offset: int  # us from the pass's start, as in every item
+    text: str
+    where: ev.Where | None
+    __match_args__ = ("offset", "text", "where")
+
+
+class Outputs(NamedTuple):
+    tag: Tag  # Tag.OUTPUTS
+    offset: int
+    pattern: int
+    __match_args__ = ("offset", "pattern")
+
+
+class Skip(NamedTuple):
+    """An inner loop's skip: `passes` passes of `shape`, `period` us each."""
+
+    tag: Tag  # Tag.SKIP
+    offset: int
+    passes: int
+    period: int
+    shape: tuple
+    loop: ev.Where
+    __match_args__ = ("offset", "passes", "period", "shape", "loop")
+
+
+class Shifted(NamedTuple):
+    """An inner skip whose first pass starts `position` counts from the outer pass's start
+    position, and each next one `shift` further."""
+
+    tag: Tag  # Tag.SHIFTED
+    offset: int
+    passes: int
+    period: int
+    shape: tuple
+    loop: ev.Where
+    position: int
+    shift: int
+    __match_args__ = ("offset", "passes", "period", "shape", "loop", "position", "shift")
+
+
+class Placed(NamedTuple):
+    """A report of `ident` showing a position `position` counts from the pass's start one."""
+
+    tag: Tag  # Tag.PLACED
+    offset: int
+    ident: str
+    position: int
+    where: ev.Where | None
+    __match_args__ = ("offset", "ident", "position", "where")
+
+
+class Absolute(NamedTuple):
+    tag: Tag  # Tag.ABSOLUTE
+
+
+class Requested(NamedTuple):
+    """A note: a move asked for `target`; a target outside lo..hi is clamped (§4.4.2)."""
+
+    target: int
+    lo: int
+    hi: int
+
+
+class Move(NamedTuple):
+    """A profile started from rest: to `target` from `origin` (both relative to the pass's
+    start position), lasting `arrival` us in segments of `dts` us."""
+
+    tag: Tag  # Tag.MOVE
+    offset: int
+    kind: ev.Motion
+    target: int
+    origin: int
+    requested: Requested | None  # relative to the pass's start; None for a stop
+    arrival: float
+    dts: tuple[float, ...]
+    __match_args__ = ("offset", "kind", "target", "origin", "requested", "arrival", "dts")
+
+
+class Arrive(NamedTuple):
+    tag: Tag  # Tag.ARRIVE
+    offset: int
+    position: int
+    __match_args__ = ("offset", "position")
+
+
+ABSOLUTE = Absolute(Tag.ABSOLUTE)
+
+
+class Shows(NamedTuple):
+    """A note: the report just logged shows the position `value` (TP, TD, TT at rest)."""
+
+    ident: str
+    value: int
+
+
+class Note(Enum):
+    """A note in the effect log about the pass it is in; never emitted."""
+
+    SWITCHES = "switches"  # the report just logged (TS) shows the switches
+    UNSHIFTABLE = "unshiftable"  # the pass did something a shifted pass cannot repeat
+
+
+class Stretch(NamedTuple):
+    """Skipped passes as a plot or a VCD draws them: those from t on left out, the last
+    one, starting at `last`, drawn in full."""
+
+    t: int
+    last: int
+    passes: int
+
+
+NOTES = (Requested, Shows, Note)  # what the effect log holds besides events
+
+
+def shape(events: list, start: int) -> tuple | None:
+    """A pass's effects relative to its start; None if one of them cannot repeat."""
+    items = []
+    for e in events:
+        match e:
+            case ev.Reported(t, text, where):
+                items.append(Report(Tag.REPORT, t - start, text, where))
+            case ev.OutputsChanged(t, pattern):
+                items.append(Outputs(Tag.OUTPUTS, t - start, pattern))
+            case ev.FastForwarded() if e.shift or not plain(e.shape):
+                return None  # moves proven exact for its own passes only
+            case ev.FastForwarded():
+                items.append(_skip(e, start))
+            case Requested() | Shows() | Note():  # NOTES
+                pass
+            case _:  # motion, inputs, hazards: not the same in the next pass
+                return None
+    return tuple(items)
+
+
+def silent(events: list, start: int) -> tuple | None:
+    """() when a pass emitted nothing (its effects are notes only), else None: all a
+    machine that skips only quiet passes needs of its shape."""
+    for e in events:
+        if not isinstance(e, NOTES):
+            return None
+    return ()
+
+
+def moved_shape(events: list, start: int, position: int) -> tuple | None:
+    """A pass's effects relative to its start time and position; None if one cannot shift."""
+    items, requested = [], None
+    for e in events:
+        match e:
+            case ev.Reported(t, text, where):
+                items.append(Report(Tag.REPORT, t - start, text, where))
+            case ev.OutputsChanged(t, pattern):
+                items.append(Outputs(Tag.OUTPUTS, t - start, pattern))
+            case Shows(ident, value):  # the report just logged shows a position
+                report = items.pop()
+                items.append(Placed(Tag.PLACED, report.offset, ident, value - position,
+                                    report.where))
+            case Requested(target, lo, hi):
+                requested = Requested(target - position, lo, hi)
+            case ev.FastForwarded() if e.shift or not plain(e.shape):
+                items.append(Shifted(Tag.SHIFTED, e.t - start, e.passes, e.period, e.shape,
+                                     e.loop, e.position - position, e.shift))
+            case ev.FastForwarded():
+                items.append(_skip(e, start))
+            case ev.MoveStarted() if e.kind == ev.Motion.MOVE or not e.segments:
+                if e.kind == ev.Motion.MOVE and requested is None:
+                    return None
+                items.append(_move(e, start, position, requested))
+                requested = None
+            case ev.MoveEnded(t, Ended.ARRIVED, at):
+                items.append(Arrive(Tag.ARRIVE, t - start, at - position))
+            case Note.SWITCHES:  # compared by value: after the events (their __eq__ is slow)
+                items.append(ABSOLUTE)
+            case _:  # a reference search, joystick, limit hit, DH, hazard, input, UNSHIFTABLE
+                return None
+    return tuple(items)
+
+
+def _skip(e: ev.FastForwarded, start: int) -> Skip:
+    return Skip(Tag.SKIP, e.t - start, e.passes, e.period, e.shape, e.loop)
+
+
+def _move(e: ev.MoveStarted, start: int, position: int, requested: Requested | None) -> Move:
+    """A profile from rest (else the pass is unshiftable): it runs from segs[0].x0 to the
+    target, one way."""
+    origin = round(e.segments[0].x0) - position if e.segments else e.target - position
+    return Move(Tag.MOVE, e.t - start, e.kind, e.target - position, origin, requested,
+                e.arrival - e.t, tuple(s.dt for s in e.segments))
+
+
+def plain(shape: tuple) -> bool:
+    """Whether a shape is the same at any position (no moves, no position reports)."""
+    for item in shape:
+        match item:
+            case Report() | Outputs():
+                pass
+            case Skip(shape=inner) if plain(inner):
+                pass
+            case _:
+                return False
+    return True
+
+
+_SELECTS = {Tag.REPORT: (Tag.REPORT, Tag.PLACED), Tag.OUTPUTS: (Tag.OUTPUTS,)}
+
+
+def count(shape: tuple, kind: Tag) -> int:
+    """How many reports (REPORT) or output changes (OUTPUTS) one pass of `shape` emits."""
+    selected, total = _SELECTS[kind], 0
+    for item in shape:
+        match item:
+            case Skip(passes=n, shape=inner) | Shifted(passes=n, shape=inner):
+                total += n * count(inner, kind)
+            case _ if item.tag in selected:
+                total += 1
+    return total
+
+
+def expand(shape: tuple, start: int, period: int, passes: int, kind: Tag,
+           position: int = 0, shift: int = 0) -> Iterator[ev.Reported | ev.OutputsChanged]:
+    """The events of `kind` that `passes` passes of `shape` from `start` emit, in time order;
+    the first pass starts at `position`, each next one `shift` further (a shifted skip)."""
+    selected = _SELECTS[kind]
+    items = [item for item in shape if item.tag in selected or
+             (item.tag in (Tag.SKIP, Tag.SHIFTED) and count(item.shape, kind))]
+    if not items:
+        return
+    for p in range(passes):
+        base, at = start + p * period, position + p * shift
+        for item in items:
+            match item:
+                case Report(offset, text, where):
+                    yield ev.Reported(base + offset, text, where)
+                case Placed(offset, ident, relative, where):
+                    yield ev.Reported(base + offset, number(ident, at + relative), where)
+                case Outputs(offset, pattern):
+                    yield ev.OutputsChanged(base + offset, pattern)
+                case Shifted(offset, n, inner_period, inner, _, relative, inner_shift):
+                    yield from expand(inner, base + offset, inner_period, n, kind,
+                                      at + relative, inner_shift)
+                case Skip(offset, n, inner_period, inner):
+                    yield from expand(inner, base + offset, inner_period, n, kind)
+
+
+def compact(shape: tuple, start: int, period: int,
+            passes: int) -> Iterator[Stretch | ev.OutputsChanged]:
+    """A skip as a plot or a VCD draws it: the Stretch of its passes, then the output changes
+    of the last pass, each inner skip drawn alike (a day of blinking is not a million
+    changes, issue 7)."""
+    last = start + (passes - 1) * period
+    yield Stretch(start, last, passes)
+    for item in shape:
+        match item:
+            case Outputs(offset, pattern):
+                yield ev.OutputsChanged(last + offset, pattern)
+            case Skip(offset, n, inner_period, inner) | Shifted(offset, n, inner_period, inner):
+                yield from compact(inner, last + offset, inner_period, n)
+
+
+# ---------------------------------------------------------------- when passes repeat
 class Loop(Enum):
     """What brings a loop round to its anchor."""
 
@@ -70,129 +345,12 @@ class Visit:
     wake: int  # when the pass starts, us
     inputs: int  # input change count so far
     waits: int  # wait instructions executed so far
-    logged: int  # effects logged so far (the machine's effect log)
+    logged: int  # effects logged so far (the optimiser's effect log)
     shape: tuple | None  # what the pass that ended here emitted; None: unknown or unrepeatable
     skey: tuple | None = None  # key without position and target; None unless at rest on target
     position: int = 0  # the target (= position) here, when skey is not None
     delta: int | None = None  # position - the last visit's; None unless skeys were equal
     moved: tuple | None = None  # moved_shape of the pass that ended here
-
-
-class Mark(NamedTuple):
-    """A note in the machine's effect log, never emitted: what a shifted pass must know."""
-
-    what: str  # PLACED (the report before it), REQUESTED, ABSOLUTE, UNSHIFTABLE
-    value: tuple = ()
-
-
-class Anchors:
-    """The last visit of every loop anchor."""
-
-    def __init__(self):
-        self.visits: dict[Anchor, Visit] = {}
-
-    def arrive(self, anchor: Anchor, visit: Visit) -> Visit | None:
-        """Record a visit; return the previous one if it bounds a pass."""
-        previous = self.visits.get(anchor)
-        self.visits[anchor] = visit
-        return previous
-
-    def forget_slot(self, slot: int) -> None:
-        """A macro was entered: its RP counters restart, so its loop visits are void."""
-        for anchor in [a for a in self.visits if a.loop is Loop.RP and a.slot == slot]:
-            del self.visits[anchor]
-
-    def forget(self, anchor: Anchor) -> None:
-        self.visits.pop(anchor, None)
-
-    def clear(self) -> None:
-        self.visits.clear()
-
-
-def key_fields(*names: str):
-    """A part's `state_key()`: its fields `names`, what decides its future, as a tuple.
-
-    Each part lists every field either there (its STATE_KEY) or in NOT_KEYED with the
-    reason it may be left out; tests/test_vm_surface.py fails when a field is in neither,
-    and when a keyed field holds a mutable value (a key must not change with the part).
-    """
-    get = attrgetter(*names)
-    if len(names) == 1:
-        def state_key(part) -> tuple:
-            return (get(part),)
-    else:
-        def state_key(part) -> tuple:
-            return get(part)
-    return state_key
-
-
-def logged(event) -> bool:
-    """Whether an event is part of a pass's effects: all but flow, and skips that emitted."""
-    if isinstance(event, ev.FastForwarded):
-        return bool(event.shape)
-    return not isinstance(event, FLOW)
-
-
-def shape(events: list, start: int) -> tuple | None:
-    """A pass's effects relative to its start; None if one of them cannot repeat."""
-    items = []
-    for e in events:
-        if type(e) is ev.Reported:
-            items.append((REPORT, e.t - start, e.text, e.where))
-        elif type(e) is ev.OutputsChanged:
-            items.append((OUTPUTS, e.t - start, e.pattern))
-        elif type(e) is ev.FastForwarded:
-            if e.shift or not plain(e.shape):  # moves proven exact for its own passes only
-                return None
-            items.append((SKIP, e.t - start, e.passes, e.period, e.shape, e.loop))
-        elif type(e) is not Mark:  # motion, inputs, hazards: not the same in the next pass
-            return None
-    return tuple(items)
-
-
-def moved_shape(events: list, start: int, position: int) -> tuple | None:
-    """A pass's effects relative to its start time and position; None if one cannot shift."""
-    items, requested = [], None
-    for e in events:
-        kind = type(e)
-        if kind is Mark:
-            if e.what == UNSHIFTABLE:
-                return None
-            if e.what == REQUESTED:
-                requested = (e.value[0] - position, *e.value[1:])
-            elif e.what == ABSOLUTE:
-                items.append((ABSOLUTE,))
-            else:  # PLACED: the report just logged shows a position
-                report = items.pop()
-                items.append((PLACED, report[1], e.value[0], e.value[1] - position, report[3]))
-        elif kind is ev.Reported:
-            items.append((REPORT, e.t - start, e.text, e.where))
-        elif kind is ev.OutputsChanged:
-            items.append((OUTPUTS, e.t - start, e.pattern))
-        elif kind is ev.FastForwarded and (e.shift or not plain(e.shape)):
-            items.append((SHIFTED, e.t - start, e.passes, e.period, e.shape, e.loop,
-                          e.position - position, e.shift))
-        elif kind is ev.FastForwarded:
-            items.append((SKIP, e.t - start, e.passes, e.period, e.shape, e.loop))
-        elif kind is ev.MoveStarted and (e.kind == "move" or not e.segments):
-            if e.kind == "move" and requested is None:
-                return None
-            # from rest (else a Mark): the profile runs from segs[0].x0 to the target, one way
-            origin = round(e.segments[0].x0) - position if e.segments else e.target - position
-            items.append((MOVE, e.t - start, e.kind, e.target - position, origin,
-                          requested, e.arrival - e.t, tuple(s.dt for s in e.segments)))
-            requested = None
-        elif kind is ev.MoveEnded and e.how == "arrived":
-            items.append((ARRIVE, e.t - start, e.position - position))
-        else:  # a reference search, joystick, limit hit, DH, hazard, input
-            return None
-    return tuple(items)
-
-
-def plain(shape: tuple) -> bool:
-    """Whether a shape is the same at any position (no moves, no position reports)."""
-    return all(item[0] in (REPORT, OUTPUTS) or (item[0] == SKIP and plain(item[4]))
-               for item in shape)
 
 
 def same_pass(previous: Visit, now: Visit) -> bool:
@@ -207,39 +365,6 @@ def same_pass(previous: Visit, now: Visit) -> bool:
     return (now.key is not None and now.key == previous.key and now.inputs == previous.inputs
             and now.wake > previous.wake and now.shape is not None
             and now.shape == previous.shape)
-
-
-def count(shape: tuple, kind: str) -> int:
-    """How many reports (or output changes) one pass of `shape` emits."""
-    kinds = (kind, PLACED) if kind == REPORT else (kind,)
-    return sum(1 if item[0] in kinds else item[2] * count(item[4], kind)
-               for item in shape if item[0] in kinds or item[0] in (SKIP, SHIFTED))
-
-
-def expand(shape: tuple, start: int, period: int, passes: int, kind: str,
-           position: int = 0, shift: int = 0) -> Iterator:
-    """The events of `kind` that `passes` passes of `shape` from `start` emit, in time order;
-    the first pass starts at `position`, each next one `shift` further (a shifted skip)."""
-    kinds = (kind, PLACED) if kind == REPORT else (kind,)
-    items = [item for item in shape
-             if item[0] in kinds or (item[0] in (SKIP, SHIFTED) and count(item[4], kind))]
-    if not items:
-        return
-    for p in range(passes):
-        base = start + p * period
-        for item in items:
-            if item[0] == REPORT:
-                yield ev.Reported(base + item[1], item[2], item[3])
-            elif item[0] == PLACED:
-                value = position + p * shift + item[3]
-                yield ev.Reported(base + item[1], number(item[2], value), item[4])
-            elif item[0] == OUTPUTS:
-                yield ev.OutputsChanged(base + item[1], item[2])
-            elif item[0] == SHIFTED:
-                yield from expand(item[4], base + item[1], item[3], item[2], kind,
-                                  position + p * shift + item[6], item[7])
-            else:
-                yield from expand(item[4], base + item[1], item[3], item[2], kind)
 
 
 def skippable(previous: Visit, now: Visit, horizon: float, remaining: float) -> int:
@@ -271,29 +396,34 @@ def shifted_passes(now: Visit, period: int, fit: int, bounds: tuple, hard: tuple
     delta, pos = now.delta, now.position
     if delta and _shows_switches(now.moved):
         return 0  # TS shows the switches: where they are crossed is not counted here
-    for item, latest, starts in _moves(now.moved, 0, (0,)):
+    for move, latest, starts in _moves(now.moved, 0, (0,)):
         for start in starts:
-            fit = min(fit, _unclamped(item, pos + start, delta, fit),
-                      _clear(item, pos + start, delta, fit, hard))
-        fit = min(fit, _same_arrival(item, now.wake + latest, period, fit))
+            fit = min(fit, _unclamped(move, pos + start, delta, fit),
+                      _clear(move, pos + start, delta, fit, hard))
+        fit = min(fit, _same_arrival(move, now.wake + latest, period, fit))
     return max(fit, 0)
 
 
 def _shows_switches(shape: tuple) -> bool:
-    return any(item[0] == ABSOLUTE or (item[0] == SHIFTED and _shows_switches(item[4]))
-               for item in shape)
+    for item in shape:
+        match item:
+            case Absolute():
+                return True
+            case Shifted(shape=inner) if _shows_switches(inner):
+                return True
+    return False
 
 
-def _moves(shape: tuple, latest: int, starts: tuple) -> Iterator:
+def _moves(shape: tuple, latest: int, starts: tuple) -> Iterator[tuple[Move, int, tuple]]:
     """Each move of a pass, with a bound on its pass's start time (relative) and the
     relative start positions of its first and last copy (inner shifted skips repeat it)."""
     for item in shape:
-        if item[0] == MOVE:
-            yield item, latest, starts
-        elif item[0] == SHIFTED:
-            n, period, rel, shift = item[2], item[3], item[6], item[7]
-            inner = tuple({s + rel + q * shift for s in starts for q in (0, n - 1)})
-            yield from _moves(item[4], latest + item[1] + n * period, inner)
+        match item:
+            case Move():
+                yield item, latest, starts
+            case Shifted(offset, n, period, inner, _, relative, shift):
+                inner_starts = tuple({s + relative + q * shift for s in starts for q in (0, n - 1)})
+                yield from _moves(inner, latest + offset + n * period, inner_starts)
 
 
 def _last_inside(lo: float, hi: float, first: int, delta: int, fit: int) -> int:
@@ -307,40 +437,39 @@ def _last_inside(lo: float, hi: float, first: int, delta: int, fit: int) -> int:
     return fit
 
 
-def _unclamped(item: tuple, pos: int, delta: int, fit: int) -> int:
+def _unclamped(move: Move, pos: int, delta: int, fit: int) -> int:
     """Passes whose move targets stay unclamped (a clamp is a soft-limit boundary)."""
-    requested = item[5]
-    if requested is None or delta == 0:  # a stop, or the very same targets every pass
+    if move.requested is None or delta == 0:  # a stop, or the very same targets every pass
         return fit
-    rel, lo, hi = requested
-    return _last_inside(lo, hi, pos + rel, delta, fit)
+    relative, lo, hi = move.requested
+    return _last_inside(lo, hi, pos + relative, delta, fit)
 
 
-def _clear(item: tuple, pos: int, delta: int, fit: int, hard: tuple | None) -> int:
+def _clear(move: Move, pos: int, delta: int, fit: int, hard: tuple | None) -> int:
     """Passes whose move stays 2 counts clear of the limit switches, in float and all (even
     unshifted: a profile's float end, taken at another time, could touch a switch it ends on)."""
     if hard is None:
         return fit
     lo, hi = hard[0] + 2, hard[1] - 2
-    low, high = sorted((item[3], item[4]))
+    low, high = sorted((move.target, move.origin))
     return min(_last_inside(lo - low, hi - low, pos, delta, fit),
                _last_inside(lo - high, hi - high, pos, delta, fit))
 
 
-def _same_arrival(item: tuple, wake: int, period: int, fit: int) -> int:
+def _same_arrival(move: Move, wake: int, period: int, fit: int) -> int:
     """Passes in which the profile's end, summed in floats from its start time, still rounds
     up to the same microsecond: each of the sums adds at most half an ulp of the time."""
-    dts = item[7]
+    _, offset, _, _, _, _, arrival, dts = move  # unpacked: any tuple laid out as a Move
     if not dts:
         return fit
     exact = sum(map(Fraction, dts), Fraction(0))
     up = math.ceil(exact)
     gap = min(exact - (up - 1), up - exact)
-    if gap <= 0 or item[6] != up:
+    if gap <= 0 or arrival != up:
         return 0
 
     def safe(n: int) -> bool:
-        latest = wake + n * period + item[1] + up + 1
+        latest = wake + n * period + offset + up + 1
         return Fraction(math.ulp(float(latest))) * len(dts) < gap
 
     lo, hi = 0, fit

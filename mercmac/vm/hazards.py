@@ -1,8 +1,10 @@
 """Hazards: what would hurt on the bench, reported once per rule and instruction.
 
 Each is a `Rule` like the checks of `mercmac.diagnostics`, with a stable code
-(MHnnn) and its story, so that `mercmac explain MH004` / `explain hard-limit`
-shows it; the simulator reports each with time and source line.
+(MHnnn), its story and its message templates, so that `mercmac explain MH004` /
+`explain hard-limit` shows it; the machine reports each with values, never wording
+(`HazardLog.add`, as `diagnostics.Report.add`), and the simulator shows it with time
+and source line.
 """
 from __future__ import annotations
 
@@ -18,49 +20,59 @@ error 0A "Servo off" in the TS report (MS176E §6.4 TS, MN/MF). The manual's
 stand-alone examples never send MN, so whether the servo is on at power-on is
 a simulator option (`sim --servo-off`); on the bench it depends on the
 controller's settings. Send MN before the first move, e.g. at the start of
-the autostart macro."""),
+the autostart macro.""", {
+        "move": "move while the servo is off: the stage will not hold or move; send MN first",
+        "search": "reference search while the servo is off; send MN first",
+    }),
     Rule("MH002", "move-joystick-on", _W, "a move was commanded while the joystick is on", """\
 While a joystick axis is enabled (JN) the controller refuses motion commands
 (MA, MR, GH, FE, ...) with error 0B (MS176E §3.6.1, §6.4 MA): the macro runs on
 but the stage does not go where the macro says. Send JF before the move and
 JN again after it, or keep joystick and macro moves in different modes
-(Example 4 switches with EM)."""),
+(Example 4 switches with EM).""", {
+        "": "move refused: the joystick is on (JN); send JF first"}),
     Rule("MH003", "soft-limit-clamp", _W, "a target beyond a soft limit was clamped to it", """\
 The soft limits set with JH and JL (MS176E §4.4.2) clamp every target: a move
 beyond them ends at the limit instead, so the position the macro expects and
 the one the stage reaches differ, and everything after it (reports, relative
 MR moves) is off by the difference. Move within the limits, widen them with
-JH/JL, or clear them with JC if the travel allows."""),
+JH/JL, or clear them with JC if the travel allows.""", {
+        "": "target {target} lies beyond the {side} soft limit: the stage stops at {clamped}"}),
     Rule("MH004", "hard-limit", _W, "the stage ran into a limit switch and stopped abruptly", """\
 The stage reached a limit switch of the travel range (MS176E §4.4.1): the
 controller stops the motor at once, without the deceleration ramp, and sets
 error 07 in the TS report. That is hard on the mechanics and the load, and
 the target was not reached. Keep targets inside the travel (the simulator
 places the switches with `sim --hard-limits NEG,POS`), or set soft limits
-with JH/JL so that moves stop in time."""),
+with JH/JL so that moves stop in time.""", {
+        "": "the stage hit the {side} limit switch at {position} and stopped abruptly"}),
     Rule("MH005", "ws-never-finishes", _W, "WS waits for an on-target state the profile never reaches", """\
 WS waits until the move is finished, then n ms (MS176E §6.4 WS). With a
 programmed velocity SV0 or acceleration SA0 the profile never reaches its
 target, so the macro hangs in WS for good and nothing after it runs. Set SV
 and SA before the move (power-on defaults: C-863 SV 45000, SA 400000; C-663
-SV 20000, SA 250000, §3.4), or use WA to wait a fixed time."""),
+SV 20000, SA 250000, §3.4), or use WA to wait a fixed time.""", {
+        "": "WS waits for a move that never ends: SV is {sv}, SA is {sa}"}),
     Rule("MH006", "busy-loop", _W, "a long loop repeats without any wait, at the full command rate", """\
 A loop (RP, or macros that call each other round) that runs many passes
 without WA, WS, WN or WF executes at the full command rate, one command per
 controller cycle (SPEC §3). A polling loop like that keeps the controller
 busy, floods the host with any reports it makes, and on a bench usually means
 a missing wait. Add a WA of a few ms to each pass (`every 20ms { ... }` does
-this for you)."""),
+this for you).""", {
+        "": "{macro} loops without a wait: it runs at the full command rate; add WA"}),
     Rule("MH007", "reference-not-found", _W, "FE searches away from the reference switch", """\
 FE starts a reference (home) search in the direction its argument gives
 (MS176E §6.4 FE, §4.3). When the reference switch lies the other way, the
 stage runs to the end of its travel and stops at the limit switch without
 having found the reference, so every later absolute move is off. Use the
 other fixed direction (FE0 / FE1), or FE2 / FE3, which pick the direction from
-the switch state. The simulator places the switch with `sim --reference-at`."""),
+the switch state. The simulator places the switch with `sim --reference-at`.""", {
+        "": "FE{mode} searches away from the reference switch and runs to the end of travel"}),
 )
 
-NAMES = frozenset(r.name for r in RULES)
+_BY_NAME = {r.name: r for r in RULES}
+NAMES = frozenset(_BY_NAME)
 
 
 class HazardLog:
@@ -69,12 +81,15 @@ class HazardLog:
     def __init__(self):
         self.seen: set[tuple] = set()
 
-    def first(self, rule: str, where_key: tuple) -> bool:
-        """True the first time this rule fires at this place."""
-        if rule not in NAMES:
+    def add(self, rule: str, where_key: tuple | None, variant: str = "", /,
+            **values) -> str | None:
+        """The message of `rule` at this place, in the words of its `variant` template, the
+        first time it fires there; None after (each is reported once)."""
+        found = _BY_NAME.get(rule)
+        if found is None:
             raise KeyError(f"unknown hazard rule {rule}")
         key = (rule, where_key)
         if key in self.seen:
-            return False
+            return None
         self.seen.add(key)
-        return True
+        return found.text(variant, **values)

@@ -3,8 +3,9 @@ from __future__ import annotations
 
 import heapq
 import math
+from dataclasses import dataclass
 
-from mercmac.vm import fastforward as ff
+from mercmac.vm.statekey import key, keyed, unkeyed
 
 INPUTS = range(1, 7)  # 1-4 pushbuttons, 5 joystick (ON above mid-scale), 6 joystick button
 
@@ -18,7 +19,6 @@ class Inputs:
         # of 100,000 presses costs O(log n) per distinct time, not a list shift per change
         self._due: dict[int, list[tuple[int, bool]]] = {}
         self._times: list[int] = []
-        self.version = 0  # bumps on every change: fast-forward must not skip one
 
     def __getitem__(self, n: int) -> bool:
         return self.state[n]
@@ -48,28 +48,23 @@ class Inputs:
         if self.state[n] == on:
             return False
         self.state[n] = on
-        self.version += 1
         return True
 
     def pattern(self) -> int:
-        """Inputs 1-4 as bits 0-3 (TC0, §6.4 TC)."""
-        return sum(1 << (n - 1) for n in range(1, 5) if self.state[n])
+        """Inputs 1-4 as bits 0-3 (TC0, §6.4 TC); spelled out, as every TS reads it."""
+        state = self.state
+        return state[1] | state[2] << 1 | state[3] << 2 | state[4] << 3
 
 
+@keyed()
+@dataclass(eq=False)
 class Outputs:
     """Four digital outputs; output 4 also carries trigger pulses (§4.5.2)."""
 
-    STATE_KEY = ("set_bits",)  # fastforward.key_fields
-    NOT_KEYED = {
-        # a time: a pulse still on bounds a skip as a hardware event (Machine._next_hardware),
-        # and one that ended shows nothing
-        "pulse_until": "when the trigger pulse on output 4 ends",
-    }
-    state_key = ff.key_fields(*STATE_KEY)
-
-    def __init__(self):
-        self.set_bits = 0  # what CN/CF/CP programmed
-        self.pulse_until = -math.inf  # output 4 is high for a trigger pulse until then
+    set_bits: int = key(default=0)  # what CN/CF/CP programmed
+    # a time: a pulse still on bounds a skip as a hardware event (Machine._next_hardware),
+    # and one that ended shows nothing
+    pulse_until: float = unkeyed("when the trigger pulse on output 4 ends", default=-math.inf)
 
     def pattern(self, t_us: float) -> int:
         """The 4-bit pattern the LEDs show at t_us (bit 0 = output 1, §6.4 CP)."""

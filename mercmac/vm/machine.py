@@ -4,43 +4,46 @@ One return point, per-RP counters, XN/XF exits, waits and reports as MS176E
 §3.8 and §6.4 describe them. The clock, the I/O lines and the axis are objects
 handed in (`Hardware`); `step()` runs one instruction, `run(until)` runs to a
 time, doing nothing between events (waits cost one comparison, not a loop).
+Fast-forward is a collaborator (vm/optimiser.py): the machine tells it what happens
+through a few named hooks and jumps over the passes it finds repeating (`_jump`).
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 from enum import Enum
-from typing import Callable, Iterable
+from operator import attrgetter
+from types import MappingProxyType
+from typing import Callable, Iterable, Mapping, NamedTuple
 
 from mercmac.commands import C663, COMMANDS, MAX_POSITION, Mnemonic
-from mercmac.compiler.program import Op, Program
+from mercmac.compiler.program import Program
+from mercmac.mdtext import slot_name
+from mercmac.ops import Op
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
 from mercmac.vm import reports
 from mercmac.vm.assemble import DIRECT, Chunk, assemble, assemble_ops
 from mercmac.vm.clock import Clock
 from mercmac.vm.disasm import instruction
-from mercmac.vm.fastforward import (Anchor, Anchors, Loop, Mark, Visit, same_pass,
-                                    same_shifted_pass, shifted_passes, skippable)
+from mercmac.vm.fastforward import Anchor
 from mercmac.vm.hazards import HazardLog
 from mercmac.vm.lines import Inputs, Outputs
 from mercmac.vm.models import DEFAULTS, Options, model_name
-from mercmac.vm.motion import Axis
+from mercmac.vm.motion import Axis, Ended
 from mercmac.vm.opcodes import Opcode
+from mercmac.vm.optimiser import Anchors, FastForward, Jump, Optimiser
+from mercmac.vm.statekey import items, key, keyed, part, sorted_items, unkeyed
 from mercmac.vm.trigger import PULSE_US, Trigger
 
 INF = math.inf
 JT_US = 2_000_000  # §6.4 JT: "Executing the JT command takes about 2 seconds"
-BUSY_PASSES = 1000  # a loop without waits this long (or endless) is a busy loop hazard
-LOG_LIMIT = 100_000  # effects kept for comparing passes; a longer pass is not skipped
-FAST_FORWARD = ("off", "quiet", "all")  # skip no passes, passes that emit nothing, or any
-
-# reports that show the position (fastforward.Mark): TP, TD, TT shift with it; TE and TV
-# do not at rest; TS shows the limit and reference switches; all but TT vary while moving
-POSITIONAL = {Mnemonic.TP, Mnemonic.TD, Mnemonic.TT, Mnemonic.TE, Mnemonic.TV, Mnemonic.TS}
 
 # §6.4 TS error codes
 E_WRONG_COMMAND, E_HARD_STOP, E_SERVO_OFF, E_JOYSTICK = 0x06, 0x07, 0x0A, 0x0B
+
+
+Listener = Callable[[object], None]  # hears each event (vm/events.py) as it happens
 
 
 class Wait(Enum):
@@ -49,6 +52,50 @@ class Wait(Enum):
     WS = Mnemonic.WS  # the move to end (on target), then n ms
     WN = Mnemonic.WN  # input n ON
     WF = Mnemonic.WF  # input n OFF
+
+
+class Blocked(NamedTuple):
+    """A wait command that blocks: what it waits for, its argument, and when it began (us)."""
+
+    wait: Wait
+    arg: int  # WS: the ms to wait once on target; WN, WF: the input line
+    began: int
+
+    def ended_by(self, n: int, on: bool) -> bool:
+        """Whether input n turning ON (`on`) or OFF ends this wait."""
+        return self.wait is not Wait.WS and self.arg == n and on == (self.wait is Wait.WN)
+
+
+class Return(NamedTuple):
+    """The one return point (§3.8.4): after the EM at `ip` - 1 of `chunk`."""
+
+    chunk: Chunk
+    ip: int
+
+
+class Here(Enum):
+    """Where a hazard is found unless told otherwise: the instruction just executed (None
+    is a place too: no instruction)."""
+
+    HERE = "here"
+
+
+HERE = Here.HERE
+
+
+def _return_key(ret: Return | None) -> tuple | None:
+    if ret is None:
+        return None
+    chunk, ip = ret
+    return chunk.slot, ip
+
+
+def _counters_key(m: Machine, own: int | None) -> tuple:
+    """All RP counters but the jumping RP's own, which a skip counts down."""
+    slot = m.chunk.slot
+    return tuple((s, tuple((ip, c) for ip, c in sorted(cs.items())
+                           if not (s == slot and ip == own)))
+                 for s, cs in sorted(m.counters.items()))
 
 
 @dataclass(slots=True)
@@ -66,73 +113,92 @@ class Hardware:
         return cls(Clock(cycle_ms), Inputs(), Outputs(), Axis(DEFAULTS[model], options), Trigger())
 
 
+@keyed("_state_key")
+@dataclass(init=False, eq=False, repr=False)
 class Machine:
-    """A Mercury controller running stored macros and direct-mode lines."""
+    """A Mercury controller running stored macros and direct-mode lines.
 
-    # Fast-forward compares this state at each loop anchor (`_state_key`). Every field is
-    # here or in NOT_KEYED with the reason it may be left out; tests/test_vm_surface.py
-    # fails when a new field is in neither, which would make a skip silently inexact.
-    STATE_KEY = ("chunk", "ip", "ret", "block", "counters", "last_rp", "params", "error",
-                 "brake", "limits_on", "limits_high", "shown", "mover",
-                 "clock", "outputs", "axis", "trigger")  # the parts: their own state_key()
-    NOT_KEYED = {
-        "model": "fixed for the machine's life",
-        "options": "fixed for the machine's life",
-        "on_report": "the observer, not the machine",
-        "on_event": "the observer, not the machine",
-        "trace": "what the observer hears, not what the machine does",
-        "fast_forward": "how far to skip, not what a pass does",
-        "_log": "fast-forward's own record of what passes emitted (Visit.shape)",
-        "_log_base": "fast-forward's own record of what passes emitted (Visit.shape)",
-        "anchors": "fast-forward's own record of the visits",
-        "_horizon": "the end of the run: it bounds a skip (skippable)",
-        "chunks": "the stored macros: load, define and RM/RZ clear the anchors",
-        "inputs": "compared on their own: Visit.inputs counts the changes, and scheduled "
-                  "ones bound a skip (_next_hardware)",
-        "wake": "the clock: Visit.wake, from which the period of a pass comes",
-        "waits": "compared on their own: Visit.waits (busy-loop hazard)",
-        "hazards": "each is reported once: one in a pass makes its shape unrepeatable",
-        "table_done": "a time: inf unless a JT table is being made, and then it bounds a "
-                      "skip as a hardware event (_next_hardware)",
-    }
+    Fast-forward compares the fields marked `key` and `part` at each loop anchor: the
+    marks give STATE_KEY, `_state_key(own)` and `unshifted(key)` (vm/statekey.py); every
+    other field says why a pass may differ in it and still repeat exactly.
+    """
+
+    # load, define and RM replace chunks and clear the anchors: a slot stands for one
+    chunk: Chunk | None = key(attrgetter("slot"))
+    ip: int = key()
+    ret: Return | None = key(_return_key)
+    block: Blocked | None = key()
+    counters: dict[int, dict[int, int]] = key(_counters_key, own=True)  # by slot, RP's ip
+    last_rp: dict[int, int] = key(sorted_items)  # the RP that last jumped, by slot (TI)
+    params: dict[str, int] = key(items)
+    error: int = key()
+    brake: bool = key()
+    limits_on: bool = key()
+    limits_high: bool = key()
+    shown: int = key()  # the output pattern the listeners last heard of
+    mover: ev.Where | None = key()  # the command a limit hit will be blamed on
+    clock: Clock = part()
+    outputs: Outputs = part()
+    axis: Axis = part(shifts=Axis.unshifted)
+    trigger: Trigger = part()
+    model: str = unkeyed("fixed for the machine's life")
+    options: Options = unkeyed("fixed for the machine's life")
+    on_report: Callable[[float, str], None] | None = unkeyed("the host, not the machine")
+    listeners: list[Listener] = unkeyed("who hears the events, not the machine")
+    trace: bool = unkeyed("what the listeners hear, not what the machine does")
+    optimiser: Optimiser = unkeyed("fast-forward itself: the visits it compares, and its own "
+                                   "record of what passes emitted (Visit.shape)")
+    chunks: dict[int, Chunk] = unkeyed("the stored macros: load, define and RM/RZ clear "
+                                       "the anchors")
+    _lines: Mapping[int, str] | None = unkeyed("the stored macros' lines (TM), read from "
+                                              "chunks; None until asked for after a change")
+    inputs: Inputs = unkeyed("compared on their own: Visit.inputs counts the changes, and "
+                             "scheduled ones bound a skip (_next_hardware)")
+    wake: int = unkeyed("the clock: Visit.wake, from which the period of a pass comes")
+    hazards: HazardLog = unkeyed("each is reported once: one in a pass makes its shape "
+                                 "unrepeatable")
+    table_done: float = unkeyed("a time: inf unless a JT table is being made, and then it "
+                                "bounds a skip as a hardware event (_next_hardware)")
 
     def __init__(self, program: Program | None = None, *, model: str | None = None,
                  cycle_ms: float = 1.0, options: Options | None = None,
                  on_report: Callable[[float, str], None] | None = None,
-                 on_event: Callable[[object], None] | None = None, trace: bool = False,
-                 hardware: Hardware | None = None, fast_forward: str = "quiet"):
+                 listeners: Iterable[Listener] = (), on_event: Listener | None = None,
+                 trace: bool = False, hardware: Hardware | None = None,
+                 fast_forward: FastForward | str = FastForward.QUIET):
         self.model = model_name(model or (program.target if program else None))
         self.options = options or Options()
         hw = hardware or Hardware.for_model(self.model, self.options, cycle_ms)
         self.clock, self.inputs, self.outputs = hw.clock, hw.inputs, hw.outputs
         self.axis, self.trigger = hw.axis, hw.trigger
-        self.on_report, self.on_event, self.trace = on_report, on_event, trace
-        # "all" skips passes that report or switch outputs too: the observer must count
-        # them from FastForwarded.shape (the Recorder does; on_report gets each report)
-        if fast_forward not in FAST_FORWARD:
-            raise ValueError(f"fast_forward must be one of {FAST_FORWARD}")
-        self.fast_forward = fast_forward
-        self._log: list = []  # effects since _log_base: what passes emitted (fastforward.shape)
-        self._log_base = 0
-        self.chunks: dict[int, Chunk] = {}
-        self.anchors = Anchors()
+        self.on_report, self.trace = on_report, trace
+        # who hears every event, in this order (a plot, a VCD, the recorder); `on_event`:
+        # a first one, for callers with a single listener (tests, a REPL)
+        self.listeners: list[Listener] = [*([on_event] if on_event else ()), *listeners]
+        self.optimiser = Optimiser(self, FastForward(fast_forward))
+        self.chunks, self._lines = {}, None
         self.hazards = HazardLog()
-        self.waits = 0
-        self._horizon = INF
         self._reset_state()
         if program is not None:
             self.load(program)
 
     # ---------------------------------------------------------------- public API
+    def _only_listener(self, listener: Listener) -> None:
+        self.listeners[:] = [listener]
+
+    # `machine.on_event = f` makes f the only listener: the single-listener spelling, kept
+    # for callers with one (it reads nothing: `listeners` is the list)
+    on_event = property(None, _only_listener)
+
     def load(self, program: Program) -> None:
         """Replace the stored macros; the machine state stays."""
         self.chunks = assemble(program, self.model)
-        self.anchors.clear()
+        self._code_changed()
 
     def define(self, slot: int, ops: Iterable[Op], name: str = "") -> None:
         """Store one macro, as MDn,... does (§3.8.1: silently replaces the old one)."""
-        self.chunks[slot] = assemble_ops(ops, slot, name or f"MC{slot:02d}", self.model)
-        self.anchors.clear()
+        self.chunks[slot] = assemble_ops(ops, slot, name or slot_name(slot), self.model)
+        self._code_changed()
 
     def power_on(self) -> None:
         """Power-on or RT: defaults per model, position 0; macro 0 starts if stored (§3.8.5)."""
@@ -142,7 +208,7 @@ class Machine:
         self.trigger.reset()
         self._outputs_changed()
         if 0 in self.chunks:
-            self._begin(0, "power-on")
+            self._begin(0, ev.Via.POWER_ON)
 
     def execute_line(self, ops: Iterable[Op]) -> None:
         """Run a direct-mode command line, as if typed (§5.7.1); it stops what ran before."""
@@ -154,15 +220,20 @@ class Machine:
         """Like EMn typed in direct mode: nothing if slot n is empty (§6.4 EM)."""
         self.stop()
         if slot in self.chunks:
-            self._begin(slot, "host")
+            self._begin(slot, ev.Via.HOST)
 
     def stop(self) -> None:
         """Any character stops a running macro or line (§3.8.3); motion goes on."""
         if self.chunk is not None:
             self._emit(ev.MacroLeft(self.clock.now, self.chunk.slot, self.chunk.label,
-                                    "stopped", None))
+                                    ev.Exit.STOPPED, None))
             self._emit(ev.ProgramEnded(self.clock.now))
         self.chunk, self.ret, self.block = None, None, None
+
+    @property
+    def anchors(self) -> Anchors:
+        """The last visit of every loop anchor (fast-forward's)."""
+        return self.optimiser.anchors
 
     @property
     def running(self) -> bool:
@@ -193,11 +264,38 @@ class Machine:
 
     def stored_macros(self) -> dict[int, str]:
         """The stored command lines by macro number, as TM lists them: {5: 'MR5000,WS100'}."""
-        return {slot: chunk.line for slot, chunk in sorted(self.chunks.items())}
+        return dict(self._stored_lines())
+
+    def _stored_lines(self) -> Mapping[int, str]:
+        """stored_macros(), read-only and read once per change of code: every snapshot holds
+        it, and a report loop takes one per report."""
+        if self._lines is None:
+            self._lines = MappingProxyType({slot: chunk.line
+                                           for slot, chunk in sorted(self.chunks.items())})
+        return self._lines
 
     def setting(self, name: str) -> int:
         """The value a setting command stored (DP, FM, SM, ...; §6.2); 0 if it has none."""
         return self.params.get(name, 0)
+
+    def snapshot(self) -> reports.Snapshot:
+        """The machine now, as its reports show it (the one thing vm/reports.py reads).
+
+        Taken once per report, so by position, in Snapshot's field order (keywords cost
+        three times as much), and the macros' lines are shared until the code changes."""
+        t, axis, trigger, options = self.clock.now, self.axis, self.trigger, self.options
+        # the settings the axis and the trigger hold, as their queries report them (JH?, ZM?)
+        settings = {**self.params, Mnemonic.JH: axis.jh, Mnemonic.JL: axis.jl,
+                    Mnemonic.JN: axis.joystick, Mnemonic.ZM: trigger.mode,
+                    Mnemonic.ZP: trigger.position, Mnemonic.ZI: trigger.increment}
+        return reports.Snapshot(
+            self.model, options.address, options.firmware,
+            axis.position(t), axis.velocity(t), axis.target, axis.moving(t), axis.sv, axis.sa,
+            self.iteration(), settings, tuple(self.inputs.state), self.inputs.pattern(),
+            self._stored_lines(), self.macro is not None, self.error,
+            axis.referenced, axis.servo, axis.negative, axis.homing, axis.joystick > 0,
+            self.brake, self.limits_on, self.limits_high, axis.reference_high(t),
+            axis.limit_switch(t))
 
     def set_error(self, code: int) -> None:
         """Record the error code that TS reports (§6.4 TS), as the serial front end does."""
@@ -287,7 +385,7 @@ class Machine:
     # ---------------------------------------------------------------- the loop
     def run(self, until: int) -> None:
         """Process every event and instruction due before `until` (us), then stop there."""
-        self._horizon = until
+        self.optimiser.running_to(until)
         while True:
             t_hw = self._next_hardware()
             t_ins = self.wake if self.chunk is not None and self.block is None else INF
@@ -306,7 +404,7 @@ class Machine:
         if chunk is None:
             return
         while self.ip >= len(chunk.code):  # end of the line: back to the return point
-            if not self._leave("end"):
+            if not self._leave(ev.Exit.END):
                 return
             chunk = self.chunk
         ip = self.ip
@@ -319,16 +417,22 @@ class Machine:
         match opcode:
             case Opcode.XN:
                 if not self.inputs.state[arg]:
-                    self._leave(f"{Mnemonic.XN}{arg}")
+                    self._leave(ev.FAILED_XN[arg])
             case Opcode.XF:
                 if self.inputs.state[arg]:
-                    self._leave(f"{Mnemonic.XF}{arg}")
+                    self._leave(ev.FAILED_XF[arg])
             case Opcode.EM:
                 self._call(arg)
             case Opcode.RP:
                 self._repeat(chunk.slot, ip, arg)
+            case Opcode.REPORT if arg[0] == Mnemonic.TS:
+                self._report(self.read_status())
+                self.optimiser.reported(Mnemonic.TS)
+            case Opcode.REPORT:
+                self._report(reports.report(arg[0], arg[1], self))
+                self.optimiser.reported(arg[0])
             case Opcode.WA:  # §6.4 WA: n ms from the start of the command
-                self.waits += 1
+                self.optimiser.wait_begun()
                 self.wake = now + max(arg * 1000, self.clock.cycle)
             case Opcode.WS:
                 self._wait_stop(arg)
@@ -341,11 +445,11 @@ class Machine:
             case Opcode.GH:  # §6.4 GH: equivalent to MA0
                 self._move(0)
             case Opcode.AB:
-                self._halt("abort")
+                self._halt(ev.Motion.ABORT)
             case Opcode.AB1:
-                self._motion("stop", self.axis.decelerate)
+                self._motion(ev.Motion.STOP, self.axis.decelerate)
             case Opcode.ST:  # §6.4 ST: back to where ST was received, smoothly
-                self._motion("stop", lambda t: self.axis.move(t, round(self.axis.position(t))))
+                self._motion(ev.Motion.STOP, lambda t: self.axis.move(t, round(self.axis.position(t))))
             case Opcode.DH:
                 self._define_home(arg)
             case Opcode.FE:
@@ -386,13 +490,6 @@ class Machine:
                 self._joystick_table(arg)
             case Opcode.SET:
                 self.params[arg[0]] = arg[1] if arg[1] is not None else COMMANDS[arg[0]].default or 0
-            case Opcode.REPORT if arg[0] == Mnemonic.TS:
-                self._report(self.read_status())
-                self._mark_report(Mnemonic.TS)
-            case Opcode.REPORT:
-                self._report(reports.report(arg[0], arg[1], self))
-                if arg[0] in POSITIONAL:
-                    self._mark_report(arg[0])
             case Opcode.RT:
                 self.power_on()
             case Opcode.RZ | Opcode.RM | Opcode.RMALL:
@@ -401,30 +498,29 @@ class Machine:
                 self.error = E_WRONG_COMMAND
 
     # ---------------------------------------------------------------- control flow
-    def _begin(self, slot: int, via: str) -> None:
+    def _begin(self, slot: int, via: ev.Via) -> None:
         """Start a macro from outside: power-on or a host's EM (no return point)."""
         self.ret, self.block, self.wake = None, None, self.clock.now
         self._enter(slot, via)
 
-    def _enter(self, slot: int, via: str) -> None:
+    def _enter(self, slot: int, via: ev.Via) -> None:
         """Enter a macro at its start; its RP counters restart (SPEC §3 Repeat counters)."""
         self.chunk, self.ip = self.chunks[slot], 0
         self.counters.pop(slot, None)
         self.last_rp.pop(slot, None)
-        self.anchors.forget_slot(slot)
         self._emit(ev.MacroEntered(self.clock.now, slot, self.chunk.label, via))
-        self._loop_anchor(Anchor(Loop.EM, slot), None, INF)
+        self.optimiser.macro_entered(slot)
 
     def _call(self, slot: int) -> None:
         """EMn: the ONE return point becomes 'after this EM' (§3.8.4); n empty: nothing."""
         if slot in self.chunks:
-            self.ret = (self.chunk, self.ip)
-            self._enter(slot, Mnemonic.EM)
+            self.ret = Return(self.chunk, self.ip)
+            self._enter(slot, ev.Via.EM)
 
-    def _leave(self, why: str) -> bool:
+    def _leave(self, why: ev.Exit) -> bool:
         """The macro ends or a condition fails: continue at the return point, or stop."""
         chunk, ret = self.chunk, self.ret
-        back, back_slot = (ret[0].label, ret[0].slot) if ret else (None, None)
+        back, back_slot = (ret.chunk.label, ret.chunk.slot) if ret else (None, None)
         self._emit(ev.MacroLeft(self.clock.now, chunk.slot, chunk.label, why, back, back_slot))
         if ret is None:
             self.chunk = None
@@ -439,76 +535,68 @@ class Machine:
         left = counters[ip] - 1 if ip in counters else n
         if left <= 0:
             counters.pop(ip, None)
-            self.anchors.forget(Anchor(Loop.RP, slot, ip))
+            self.optimiser.loop_ended(slot, ip)
             return
         counters[ip] = left
         self.last_rp[slot] = ip
         self.ip = 0
-        self._loop_anchor(Anchor(Loop.RP, slot, ip), ip, left - 1)
+        self.optimiser.loop_jumped(slot, ip, left - 1)
 
     # ---------------------------------------------------------------- waits
     def _wait_stop(self, n: int) -> None:
         """WSn: until on target (§4.2), then n ms (§6.4 WS)."""
-        self.waits += 1
+        self.optimiser.wait_begun()
         if self.axis.stalled:
-            self._hazard("ws-never-finishes",
-                         f"WS waits for a move that never ends: SV is {self.axis.sv}, "
-                         f"SA is {self.axis.sa}")
+            self._hazard("ws-never-finishes", sv=self.axis.sv, sa=self.axis.sa)
         if self.axis.moving(self.clock.now):
-            self.block = (Wait.WS, n, self.clock.now)
+            self.block = Blocked(Wait.WS, n, self.clock.now)
         else:
             self.wake = self.clock.now + max(n * 1000, self.clock.cycle)
 
     def _wait_input(self, n: int, on: bool) -> None:
         """WNn / WFn: until input n is ON / OFF (§6.4 WN, WF)."""
-        self.waits += 1
+        self.optimiser.wait_begun()
         if self.inputs.state[n] != on:
-            self.block = (Wait.WN if on else Wait.WF, n, self.clock.now)
+            self.block = Blocked(Wait.WN if on else Wait.WF, n, self.clock.now)
 
     def _unblock(self, t: int) -> None:
         """A wait ends at t; the next command runs then, one cycle after the wait at least."""
-        kind, value, began = self.block
-        extra = value * 1000 if kind is Wait.WS else 0
-        self.wake = max(t + extra, began + self.clock.cycle)
+        block = self.block
+        extra = block.arg * 1000 if block.wait is Wait.WS else 0
+        self.wake = max(t + extra, block.began + self.clock.cycle)
         self.block = None
 
     # ---------------------------------------------------------------- motion
     def _move(self, target: int) -> None:
         """MA/MR/GH: refused with the joystick on or servo off; soft limits clamp (§4.4.2)."""
         if self.axis.joystick:
-            return self._refuse("move-joystick-on", E_JOYSTICK,
-                                "move refused: the joystick is on (JN); send JF first")
+            return self._refuse("move-joystick-on", E_JOYSTICK)
         if not self.axis.servo:
-            return self._refuse("move-servo-off", E_SERVO_OFF,
-                                "move while the servo is off: the stage will not hold or move; "
-                                "send MN first")
+            return self._refuse("move-servo-off", E_SERVO_OFF, "move")
         clamped = min(max(target, self.axis.jl), self.axis.jh, MAX_POSITION)
         clamped = max(clamped, -MAX_POSITION)
-        self._log.append(Mark(ff.REQUESTED, (target, *self._soft_range())))
+        self.optimiser.move_requested(target)
         if clamped != target:
             side = "upper" if clamped < target else "lower"
-            self._hazard("soft-limit-clamp",
-                         f"target {target} lies beyond the {side} soft limit: the stage stops at {clamped}")
-        self._motion("move", lambda t: self.axis.move(t, clamped))
+            self._hazard("soft-limit-clamp", target=target, side=side, clamped=clamped)
+        self._motion(ev.Motion.MOVE, lambda t: self.axis.move(t, clamped))
 
-    def _refuse(self, rule: str, code: int, message: str) -> None:
+    def _refuse(self, rule: str, code: int, variant: str = "") -> None:
         if self.model != C663:  # the C-663 error list ends at 06 (§6.4 TS)
             self.error = code
-        self._hazard(rule, message)
+        self._hazard(rule, variant)
 
-    def _motion(self, kind: str, command: Callable[[float], None]) -> None:
-        """Run an axis command now and tell the observer about the new profile."""
+    def _motion(self, kind: ev.Motion, command: Callable[[float], None]) -> None:
+        """Run an axis command now and tell the listeners about the new profile."""
         t = self.clock.now
-        axis = self.axis
-        if axis.segs or axis.stalled or not float(axis.final).is_integer():
-            self._log.append(Mark(ff.UNSHIFTABLE))  # not from rest on a count: floats differ
+        self.optimiser.profile_starting()
         command(t)
         self.mover = self._where(self.ip - 1)  # the command a limit hit will be blamed on
         self._emit(ev.MoveStarted(t, kind, self.axis.target,
                                   self.axis.arrival() if self.axis.moving(t) else t,
                                   tuple(self.axis.segs), self.mover))
 
-    def _halt(self, kind: str) -> None:
+    def _halt(self, kind: ev.Motion) -> None:
         self._motion(kind, self.axis.halt)
 
     def _define_home(self, value: int) -> None:
@@ -517,19 +605,16 @@ class Machine:
 
     def _find_edge(self, mode: int) -> None:
         if not self.axis.servo:
-            return self._refuse("move-servo-off", E_SERVO_OFF,
-                                "reference search while the servo is off; send MN first")
+            return self._refuse("move-servo-off", E_SERVO_OFF, "search")
         found = []
-        self._motion("home search", lambda t: found.append(self.axis.find_edge(t, mode)))
+        self._motion(ev.Motion.HOME_SEARCH, lambda t: found.append(self.axis.find_edge(t, mode)))
         if not found[0]:
-            self._hazard("reference-not-found",
-                         f"{Mnemonic.FE}{mode} searches away from the reference switch and runs "
-                         "to the end of travel")
+            self._hazard("reference-not-found", mode=mode)
 
     def _servo(self, on: bool) -> None:
         """MN: servo on, target := position (§6.4 MN); MF: servo off, the profile stops."""
         if self.axis.moving(self.clock.now):
-            self._halt("abort")
+            self._halt(ev.Motion.ABORT)
         elif on:
             self.axis.halt(self.clock.now)  # jerk-free: the target is where the stage is
         self.axis.servo = on
@@ -541,9 +626,9 @@ class Machine:
 
     def _drive_joystick(self) -> None:
         if self.axis.joystick and self.inputs.state[5]:
-            self._motion("joystick", lambda t: self.axis.move(t, self.axis.jh, self.axis.joystick))
+            self._motion(ev.Motion.JOYSTICK, lambda t: self.axis.move(t, self.axis.jh, self.axis.joystick))
         elif self.axis.moving(self.clock.now):
-            self._motion("stop", self.axis.decelerate)
+            self._motion(ev.Motion.STOP, self.axis.decelerate)
 
     # ---------------------------------------------------------------- I/O
     def _set_outputs(self, bits: int) -> None:
@@ -565,8 +650,7 @@ class Machine:
         else:
             self.trigger.increment = value
         self.trigger.rearm()
-        if self.trigger.mode:  # pulses at positions: not counted as boundaries
-            self._log.append(Mark(ff.UNSHIFTABLE))
+        self.optimiser.trigger_set()
 
     def _joystick_table(self, table: int) -> None:
         self.params[Mnemonic.JT] = table
@@ -578,22 +662,6 @@ class Machine:
         self._emit(ev.Reported(t, text, self._where(self.ip - 1)))
         if self.on_report:
             self.on_report(t / 1000, text)
-
-    def _mark_report(self, mnemonic: str) -> None:
-        """Note how the report just made depends on the position (fastforward.moved_shape)."""
-        axis = self.axis
-        if mnemonic == Mnemonic.TT:
-            self._log.append(Mark(ff.PLACED, (COMMANDS[mnemonic].report, axis.target)))
-        elif axis.segs or axis.stalled or not float(axis.final).is_integer():
-            self._log.append(Mark(ff.UNSHIFTABLE))
-        elif mnemonic == Mnemonic.TS:
-            self._log.append(Mark(ff.ABSOLUTE))
-        elif mnemonic in (Mnemonic.TP, Mnemonic.TD):
-            self._log.append(Mark(ff.PLACED, (COMMANDS[mnemonic].report, int(axis.final))))
-
-    def _soft_range(self) -> tuple[int, int]:
-        """Where a target is not clamped: the soft limits within the 32-bit range (§4.4.2)."""
-        return max(self.axis.jl, -MAX_POSITION), min(self.axis.jh, MAX_POSITION)
 
     def _remove(self, opcode: Opcode, slot: int | None) -> None:
         """RZ, RM n, RM, RMALL (§6.4): erase stored macros; RMALL resets parameters too."""
@@ -607,7 +675,12 @@ class Machine:
         if opcode is Opcode.RMALL:
             self.params = dict(DEFAULTS[self.model].settings)
             self.axis.sv, self.axis.sa = DEFAULTS[self.model].sv, DEFAULTS[self.model].sa
-        self.anchors.clear()
+        self._code_changed()
+
+    def _code_changed(self) -> None:
+        """The stored macros changed: their lines are read again, their loops compared anew."""
+        self._lines = None
+        self.optimiser.code_changed()
 
     # ---------------------------------------------------------------- hardware events
     def _next_hardware(self) -> float:
@@ -633,161 +706,70 @@ class Machine:
 
     def _input_changed(self, n: int, on: bool) -> None:
         t = self.clock.now
+        self.optimiser.input_changed()
         self._emit(ev.InputChanged(t, n, on))
-        if self.block and self.block[0] in (Wait.WN, Wait.WF) and self.block[1] == n:
-            if on == (self.block[0] is Wait.WN):
-                self._unblock(t)
+        if self.block and self.block.ended_by(n, on):
+            self._unblock(t)
         if n == 5 and self.axis.joystick:
             self._drive_joystick()
 
     def _pulse(self, t: int) -> None:
-        self._log.append(Mark(ff.UNSHIFTABLE))
+        self.optimiser.pulsed()
         self.trigger.fire(t)
         self.outputs.pulse_until = t + PULSE_US
         self._outputs_changed()
 
     def _axis_event(self, t: int) -> None:
-        happened = self.axis.advance(t)
-        if happened is None:
+        ending = self.axis.advance(t)
+        if ending is None:
             return
-        if happened[0] == "limit":
+        if ending.how is Ended.LIMIT:
             self.error = E_HARD_STOP
-            self._hazard("hard-limit", f"the stage hit the {happened[1]} limit switch at "
-                         f"{round(self.axis.final)} and stopped abruptly", where=self.mover)
-        self._emit(ev.MoveEnded(t, happened[0], round(self.axis.final)))
-        if self.block and self.block[0] is Wait.WS:
+            self._hazard("hard-limit", side=ending.side, position=round(self.axis.final),
+                         where=self.mover)
+        self._emit(ev.MoveEnded(t, ending.how, round(self.axis.final)))
+        if self.block and self.block.wait is Wait.WS:
             self._unblock(t)
 
     # ---------------------------------------------------------------- fast-forward
-    def _loop_anchor(self, anchor: Anchor, own: int | None, remaining: float) -> None:
-        """A loop came round: report a busy loop, skip identical passes (fastforward.py)."""
-        previous = self.anchors.visits.get(anchor)
-        key = self._state_key(own)
-        if previous is not None:
-            self._busy_loop(anchor, key, previous, remaining)
-        visit = self._visit(key, previous)
-        self.anchors.arrive(anchor, visit)
-        if previous is None or self.fast_forward == "off":
-            return
-        if not same_pass(previous, visit):
-            if self.fast_forward == "all" and same_shifted_pass(previous, visit):
-                self._skip_shifted(anchor, own, previous, visit, remaining)
-            return
-        if visit.shape and self.fast_forward != "all":
-            return
-        passes = skippable(previous, visit, min(self._horizon, self._next_hardware()), remaining)
-        if passes > 0:
-            self._skip(anchor, own, passes, visit.wake - previous.wake, visit)
-
-    def _skip_shifted(self, anchor: Anchor, own: int | None, previous: Visit, visit: Visit,
-                      remaining: float) -> None:
-        """Skip passes that repeat `visit.delta` further on, up to the next boundary."""
-        period = visit.wake - previous.wake
-        fit = skippable(previous, visit, min(self._horizon, self._next_hardware()), remaining)
-        hard = self.options.hard_limits
-        if hard is not None:
-            hard = (hard[0] + self.axis.shift, hard[1] + self.axis.shift)
-        passes = shifted_passes(visit, period, fit, self._soft_range(), hard)
-        if passes < fit:  # a boundary, not the counter, ends it: enclosing passes differ
-            self._log.append(Mark(ff.UNSHIFTABLE))
-        if passes > 0:
-            self._skip(anchor, own, passes, period, visit, visit.delta)
-
-    def _busy_loop(self, anchor: Anchor, key: tuple | None, previous: Visit,
-                   remaining: float) -> None:
-        """Report a long loop without waits, once; it ends the pass, so that pass is not
-        skipped (a loop is skipped after two passes without a new hazard, as plain
-        stepping would report none in the passes skipped)."""
-        looped = anchor.loop is Loop.RP or (key is not None and key == previous.key)
-        if looped and self.waits == previous.waits and remaining >= BUSY_PASSES:
-            self._hazard("busy-loop", f"{self.chunk.label} loops without a wait: it runs at "
-                         f"the full command rate; add WA", where=self._where_anchor(anchor))
-
-    def _visit(self, key: tuple | None, previous: Visit | None) -> Visit:
-        """This arrival at an anchor, with what the pass since `previous` emitted."""
-        if len(self._log) > LOG_LIMIT:  # passes this long are not compared
-            self._log_base += len(self._log)
-            self._log.clear()
-        pass_shape = moved = delta = None
-        whole = previous is not None and previous.logged >= self._log_base
-        if whole and key is not None and key == previous.key:
-            pass_shape = ff.shape(self._log[previous.logged - self._log_base:], previous.wake)
-        skey, position = self._shift_key(key)
-        if (whole and pass_shape is None and skey is not None and skey == previous.skey
-                and self.fast_forward == "all"):
-            delta = position - previous.position
-            moved = ff.moved_shape(self._log[previous.logged - self._log_base:],
-                                   previous.wake, previous.position)
-        return Visit(key, self.wake, self.inputs.version, self.waits,
-                     self._log_base + len(self._log), pass_shape, skey, position, delta, moved)
-
-    def _shift_key(self, key: tuple | None) -> tuple[tuple | None, int]:
-        """The state key without the axis's position and target, and the target; (None, 0)
-        unless the axis rests on its target, a whole count, with no trigger set."""
-        axis = self.axis
-        if key is None or axis.final != axis.target or self.trigger.mode:
-            return None, 0
-        axis_key = key[-2]  # Axis.STATE_KEY: segs, final, target, ...
-        return key[:-2] + (axis_key[:1] + axis_key[3:], key[-1]), axis.target
-
-    def _skip(self, anchor: Anchor, own: int | None, passes: int, period: int,
-              visit: Visit, shift: int = 0) -> None:
-        """Skip `passes` copies of the pass that ended at `visit`, each `shift` further on
-        than the last; the clock, the position and the target jump exactly."""
-        start, position = self.wake, visit.position
-        shape = visit.moved if shift or visit.shape is None else visit.shape
-        self.wake += passes * period
-        if own is not None:
-            self.counters[self.chunk.slot][own] -= passes
-        if shift:  # at rest on the target (_shift_key): both move on by whole counts
-            self.axis.target += passes * shift
-            self.axis.final = float(self.axis.target)
+    def _jump(self, jump: Jump) -> None:
+        """Skip the passes the optimiser found repeating (vm/optimiser.py), each `jump.shift`
+        further on than the last: the clock, the position and the target jump exactly."""
+        start = self.wake
+        self.wake += jump.passes * jump.period
+        if jump.own is not None:
+            self.counters[self.chunk.slot][jump.own] -= jump.passes
+        if jump.shift:  # at rest on the target: both move on by whole counts
+            self.axis.rest_at(self.axis.target + jump.passes * jump.shift)
         if self.on_report is not None:  # the host hears every report (mercmac emulate)
-            for r in ff.expand(shape, start, period, passes, ff.REPORT, position, shift):
+            for r in ff.expand(jump.shape, start, jump.period, jump.passes, ff.REPORT,
+                               jump.position, jump.shift):
                 self.on_report(r.t / 1000, r.text)
-        self._emit(ev.FastForwarded(start, self.wake, passes, period,
-                                    self._where_anchor(anchor), shape, position, shift))
-        # after the skip's own event: it belongs to enclosing loops, not to the next pass
-        key = self._state_key(own)
-        skey, now = self._shift_key(key)
-        self.anchors.arrive(anchor, Visit(key, self.wake, self.inputs.version, self.waits,
-                                          self._log_base + len(self._log), visit.shape,
-                                          skey, now, visit.delta, visit.moved))
+        self._emit(ev.FastForwarded(start, self.wake, jump.passes, jump.period,
+                                    self._where_anchor(jump.anchor), jump.shape,
+                                    jump.position, jump.shift))
 
-    def _state_key(self, own: int | None) -> tuple | None:
-        """The whole machine state except the clock and the jumping RP's own counter
-        (STATE_KEY); None while the axis moves."""
-        if self.axis.moving(self.clock.now) or self.axis.segs:
-            return None
-        # written out, in STATE_KEY's order, as it runs at every anchor; the chunks are
-        # replaced only by load, define and RM, which clear the anchors: a slot stands for one
-        slot = self.chunk.slot
-        counters = tuple((s, tuple((ip, c) for ip, c in sorted(cs.items())
-                                   if not (s == slot and ip == own)))
-                         for s, cs in sorted(self.counters.items()))
-        ret = (self.ret[0].slot, self.ret[1]) if self.ret else None
-        return (slot, self.ip, ret, self.block, counters, tuple(sorted(self.last_rp.items())),
-                tuple(self.params.items()), self.error, self.brake, self.limits_on,
-                self.limits_high, self.shown, self.mover, self.clock.state_key(),
-                self.outputs.state_key(), self.axis.state_key(), self.trigger.state_key())
+    def _busy_loop(self, anchor: Anchor) -> None:
+        """The optimiser found a long loop without a wait at `anchor`."""
+        self._hazard("busy-loop", macro=self.chunk.label, where=self._where_anchor(anchor))
 
     # ---------------------------------------------------------------- bookkeeping
     def _reset_state(self) -> None:
-        self.chunk: Chunk | None = None
+        self.chunk = None
         self.ip = 0
-        self.ret: tuple[Chunk, int] | None = None
-        self.block: tuple | None = None
+        self.ret = None
+        self.block = None
         self.wake = self.clock.now
-        self.counters: dict[int, dict[int, int]] = {}
-        self.last_rp: dict[int, int] = {}
+        self.counters = {}
+        self.last_rp = {}
         self.params = dict(DEFAULTS[self.model].settings)
         self.error = 0
         self.brake, self.limits_on = True, True  # §3.4: BN, LN
         self.limits_high = DEFAULTS[self.model].limits_high
         self.table_done = INF
         self.shown = 0
-        self.mover: ev.Where | None = None
-        self.anchors.clear()
+        self.mover = None
+        self.optimiser.code_changed()
 
     def _where(self, ip: int) -> ev.Where | None:
         chunk = self.chunk
@@ -801,14 +783,16 @@ class Machine:
         span = chunk.spans[ip] if ip < len(chunk.spans) else None
         return ev.Where(chunk.label, chunk.slot, ip, span)
 
-    def _hazard(self, rule: str, message: str, where: ev.Where | None | str = "here") -> None:
-        where = self._where(self.ip - 1) if where == "here" else where
+    def _hazard(self, rule: str, variant: str = "", /, *,
+                where: ev.Where | None | Here = HERE, **values) -> None:
+        """Report `rule` in the words of its `variant` message (vm/hazards.py), once per place."""
+        where = self._where(self.ip - 1) if where is HERE else where
         place = (where.slot, where.ip) if where else None
-        if self.hazards.first(rule, place):
+        message = self.hazards.add(rule, place, variant, **values)
+        if message is not None:
             self._emit(ev.HazardFound(self.clock.now, rule, message, where))
 
     def _emit(self, event: object) -> None:
-        if ff.logged(event):
-            self._log.append(event)
-        if self.on_event is not None:
-            self.on_event(event)
+        self.optimiser.emitted(event)
+        for listener in self.listeners:
+            listener(event)

@@ -8,45 +8,91 @@ to the current home, hard ones do not).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import NamedTuple
 
 from mercmac.commands import MAX_POSITION
-from mercmac.vm import fastforward as ff
+from mercmac.ops import TextEnum
 from mercmac.vm.models import Defaults, Options
+from mercmac.vm.statekey import key, keyed, unkeyed
 from mercmac.vm.trapezoid import PER_S, PER_S2, Segment, plan, stop
 
 INF = math.inf
 
 
+class Side(TextEnum):
+    """A limit switch of the travel (§4.4.1)."""
+
+    POSITIVE = "positive"
+    NEGATIVE = "negative"
+
+
+class Ended(TextEnum):
+    """How a profile ended (events.MoveEnded.how)."""
+
+    ARRIVED = "arrived"  # on target
+    LIMIT = "limit"  # stopped abruptly by a hard limit switch
+
+
+class Ending(NamedTuple):
+    """What `Axis.advance` found: the profile ended, and at which switch if at one."""
+
+    how: Ended
+    side: Side | None = None
+
+
+class LimitHit(NamedTuple):
+    """When the running profile first reaches a limit switch, and which one."""
+
+    t: int
+    side: Side
+
+
+@keyed()
+@dataclass(eq=False)
 class Axis:
-    """One motor axis with a trapezoidal profile generator."""
+    """One motor axis with a trapezoidal profile generator.
 
-    # fast-forward's state key (fastforward.key_fields): everything that decides future motion
-    STATE_KEY = ("segs", "final", "target", "shift", "sv", "sa", "jh", "jl", "servo",
-                 "joystick", "homing", "referenced", "stalled", "edge_ahead", "negative", "limit")
-    NOT_KEYED = {
-        "defaults": "the model's power-on values: fixed for the axis's life",
-        "options": "bench facts (switch positions, servo at power-on): fixed for the axis's life",
-    }
-    state_key = ff.key_fields(*STATE_KEY)
+    Every field but the two fixed ones decides future motion: fast-forward's state key.
+    """
 
-    def __init__(self, defaults: Defaults, options: Options):
-        self.defaults, self.options = defaults, options
+    defaults: Defaults = unkeyed("the model's power-on values: fixed for the axis's life")
+    options: Options = unkeyed("bench facts (switch positions, servo at power-on): fixed "
+                               "for the axis's life")
+    segs: tuple[Segment, ...] = key(init=False)  # a tuple: replaced, never changed in place
+    final: float = key(init=False, shifts=True)  # where the axis rests once segs are done
+    target: int = key(init=False, shifts=True)
+    shift: float = key(init=False)  # coordinates = physical position + shift (DH)
+    sv: int = key(init=False)
+    sa: int = key(init=False)
+    jh: int = key(init=False)
+    jl: int = key(init=False)
+    servo: bool = key(init=False)
+    joystick: int = key(init=False)  # JN velocity, 0 = off
+    homing: bool = key(init=False)
+    referenced: bool = key(init=False)
+    stalled: bool = key(init=False)
+    edge_ahead: bool = key(init=False)  # the running FE search heads for the edge (not away)
+    negative: bool = key(init=False)  # last move direction, TS block 3 bit 2
+    limit: LimitHit | None = key(init=False)
+
+    def __post_init__(self):
         self.reset()
 
     def reset(self) -> None:
         """Power-on state: position 0 (§3.5.1: "upon power-on ... set to zero")."""
-        self.segs: tuple[Segment, ...] = ()  # a tuple: replaced, never changed in place
-        self.final = 0.0  # where the axis rests once segs are done
+        self.segs = ()
+        self.final = 0.0
         self.target = 0
-        self.shift = 0.0  # coordinates = physical position + shift (DH)
+        self.shift = 0.0
         self.sv, self.sa = self.defaults.sv, self.defaults.sa
         self.jh, self.jl = self.defaults.jh, self.defaults.jl
         self.servo = self.options.servo_on
-        self.joystick = 0  # JN velocity, 0 = off
+        self.joystick = 0
         self.homing = self.referenced = self.stalled = False
-        self.edge_ahead = False  # the running FE search heads for the edge (not away from it)
-        self.negative = False  # last move direction, TS block 3 bit 2
-        self.limit: tuple[float, str] | None = None  # (time, 'positive'|'negative')
+        self.edge_ahead = False
+        self.negative = False
+        self.limit = None
 
     # -- reading the state --
     def _seg(self, t: float) -> Segment | None:
@@ -77,14 +123,28 @@ class Axis:
         """The reference line: high on the negative side of the switch (§6.4 FE2)."""
         return self.position(t) - self.shift < self.options.reference_at
 
-    def limit_switch(self, t: float) -> str | None:
-        """'positive'/'negative' while a hard limit switch is pressed."""
+    def at_rest_on_count(self) -> bool:
+        """Still, with its rest position a whole count: a move from here shifts exactly."""
+        return not (self.segs or self.stalled or not float(self.final).is_integer())
+
+    def soft_range(self) -> tuple[int, int]:
+        """Where a target is not clamped: the soft limits within the 32-bit range (§4.4.2)."""
+        return max(self.jl, -MAX_POSITION), min(self.jh, MAX_POSITION)
+
+    def switches(self) -> tuple[float, float] | None:
+        """The hard limit switches in present coordinates (DH shifts them, §4.4.2), if any."""
+        if self.options.hard_limits is None:
+            return None
+        lo, hi = self.options.hard_limits
+        return lo + self.shift, hi + self.shift
+
+    def limit_switch(self, t: float) -> Side | None:
+        """The hard limit switch pressed at t, if one is."""
         if self.options.hard_limits is None:
             return None
         lo, hi = self.options.hard_limits
         p = self.position(t) - self.shift
-        return "positive" if p >= hi else "negative" if p <= lo else None
-
+        return Side.POSITIVE if p >= hi else Side.NEGATIVE if p <= lo else None
 
     # -- commanding it --
     def move(self, t: float, target: int, vmax: float | None = None) -> None:
@@ -139,45 +199,52 @@ class Axis:
 
     def _runaway(self, positive: bool) -> float:
         """Where a search in the wrong direction ends: the limit switch, or out of range."""
-        if self.options.hard_limits is not None:
-            lo, hi = self.options.hard_limits
-            return (hi if positive else lo) + self.shift
+        switches = self.switches()
+        if switches is not None:
+            return switches[1] if positive else switches[0]
         return MAX_POSITION if positive else -MAX_POSITION
 
     # -- events --
     def _find_limit(self) -> None:
         """Schedule the first crossing of a hard limit switch by the new profile."""
         self.limit = None
-        if self.options.hard_limits is None:
+        switches = self.switches()
+        if switches is None:
             return
-        lo, hi = (p + self.shift for p in self.options.hard_limits)
+        lo, hi = switches
         for seg in self.segs:
             end = seg.x(seg.t1)
-            for side, edge, toward in (("positive", hi, end > seg.x0), ("negative", lo, end < seg.x0)):
+            for side, edge, toward in ((Side.POSITIVE, hi, end > seg.x0),
+                                       (Side.NEGATIVE, lo, end < seg.x0)):
                 when = seg.time_at(edge) if toward else None
                 if when is not None:
-                    self.limit = (math.ceil(when), side)
+                    self.limit = LimitHit(math.ceil(when), side)
                     return
 
     def next_event(self) -> float:
         """Time of the next arrival or limit hit, INF if none."""
         if self.limit is not None:
-            return self.limit[0]
+            return self.limit.t
         end = self.arrival()
         return end if self.segs else INF
 
-    def advance(self, t: float) -> tuple[str, float] | None:
-        """Handle the event due at t: ('limit', side) or ('arrived', position)."""
-        if self.limit is not None and self.limit[0] <= t:
-            side = self.limit[1]
-            lo, hi = (p + self.shift for p in self.options.hard_limits)
+    def advance(self, t: float) -> Ending | None:
+        """Handle the event due at t: a limit hit or the arrival; None if none is due."""
+        if self.limit is not None and self.limit.t <= t:
+            side = self.limit.side
+            lo, hi = self.switches()
             self.halt(t)
-            self.final = hi if side == "positive" else lo
+            self.final = hi if side is Side.POSITIVE else lo
             self.target = round(self.final)
-            return ("limit", side)
+            return Ending(Ended.LIMIT, side)
         if self.segs and self.arrival() <= t:
             self.segs = ()
             self.referenced = self.referenced or (self.homing and self.edge_ahead)
             self.homing = False
-            return ("arrived", self.final)
+            return Ending(Ended.ARRIVED)
         return None
+
+    def rest_at(self, target: int) -> None:
+        """At rest on the target, both move to `target` (a shifted skip, vm/optimiser.py)."""
+        self.target = target
+        self.final = float(target)

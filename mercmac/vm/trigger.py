@@ -6,25 +6,29 @@ second. Grid mode (ZM3) pulses whenever the position crosses a multiple of ZI.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
-from mercmac.vm import fastforward as ff
 from mercmac.vm.motion import Axis
+from mercmac.vm.statekey import key, keyed, unkeyed
 
 PULSE_US = 100
 
 
+@keyed()
+@dataclass(eq=False)
 class Trigger:
     """Trigger mode and positions; finds the time of the next pulse on a profile."""
 
-    STATE_KEY = ("mode", "position", "increment", "next_at", "done")  # fastforward.key_fields
-    NOT_KEYED = {
-        # a time, compared with the pulse times of a profile; the key is taken only while
-        # no profile runs, and a pass that moves never repeats
-        "last_t": "the time of the last pulse",
-    }
-    state_key = ff.key_fields(*STATE_KEY)
+    mode: int = key(init=False)  # ZM: 0 off, 1 single, 2 multiple, 3 grid
+    position: int = key(init=False)  # ZP
+    increment: int = key(init=False)  # ZI
+    next_at: int = key(init=False)  # where the next pulse of mode 1 or 2 fires
+    done: bool = key(init=False)  # single mode has fired
+    # a time, compared with the pulse times of a profile; the key is taken only while
+    # no profile runs, and a pass that moves never repeats
+    last_t: float = unkeyed("the time of the last pulse", init=False)
 
-    def __init__(self):
+    def __post_init__(self):
         self.reset()
 
     def reset(self) -> None:
@@ -36,8 +40,7 @@ class Trigger:
         """Any ZM/ZP/ZI restarts the sequence at ZP."""
         self.next_at = self.position
         self.last_t = -math.inf
-        self.done = False  # single mode has fired
-
+        self.done = False
 
     def next_time(self, axis: Axis, now: float) -> float:
         """The time of the next pulse after `now` (inf if none while the profile runs)."""

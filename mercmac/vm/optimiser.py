@@ -1,0 +1,241 @@
+"""The fast-forward optimiser of one machine: its loops' last visits, its effect log and the
+horizon of its run (the rules of when passes repeat are in vm/fastforward.py).
+
+The machine runs every instruction itself and tells its optimiser what matters through a
+few named hooks: a macro was entered, a loop came round or ran out, a wait began, an
+input changed, an event was emitted, and what a shifted pass must know (a move asked
+for, a profile started, a report that shows the position, a trigger). At a loop anchor
+the optimiser compares this pass with the last one and, when the next passes are copies,
+has the machine jump over them (`Machine._jump`), exactly.
+"""
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, NamedTuple
+
+from mercmac.commands import COMMANDS, Mnemonic
+from mercmac.ops import TextEnum
+from mercmac.vm import events as ev
+from mercmac.vm import fastforward as ff
+from mercmac.vm.fastforward import Anchor, Loop, Note, Visit
+
+if TYPE_CHECKING:
+    from mercmac.vm.machine import Machine
+
+INF = math.inf
+BUSY_PASSES = 1000  # a loop without waits this long (or endless) is a busy loop hazard
+LOG_LIMIT = 100_000  # effects kept for comparing passes; a longer pass is not skipped
+
+FLOW = (ev.MacroEntered, ev.MacroLeft, ev.Executed)  # control flow: repeats with the pass
+
+# reports that show the position: TP, TD, TT shift with it; TE and TV do not at rest;
+# TS shows the limit and reference switches; all but TT vary while moving
+POSITIONAL = {Mnemonic.TP, Mnemonic.TD, Mnemonic.TT, Mnemonic.TE, Mnemonic.TV, Mnemonic.TS}
+
+
+class FastForward(TextEnum):
+    """Which repeating passes a machine skips."""
+
+    OFF = "off"  # none: every pass is stepped (for comparisons)
+    QUIET = "quiet"  # passes that emit nothing
+    # any: a listener counts what the skipped passes emitted from FastForwarded.shape (the
+    # Recorder does; on_report gets each report)
+    ALL = "all"
+
+
+class Jump(NamedTuple):
+    """Passes the machine skips at once: `passes` copies of the pass that ended at an
+    anchor, `period` us each, each one `shift` counts further on than the last."""
+
+    anchor: Anchor
+    own: int | None  # the jumping RP's place, whose counter counts the passes
+    passes: int
+    period: int
+    shape: tuple  # what each pass emitted (fastforward.shape or moved_shape)
+    position: int  # where the first pass starts (a shifted jump)
+    shift: int
+
+
+class Anchors:
+    """The last visit of every loop anchor."""
+
+    def __init__(self):
+        self.visits: dict[Anchor, Visit] = {}
+
+    def forget_slot(self, slot: int) -> None:
+        """A macro was entered: its RP counters restart, so its loop visits are void."""
+        for anchor in [a for a in self.visits if a.loop is Loop.RP and a.slot == slot]:
+            del self.visits[anchor]
+
+
+class Optimiser:
+    """Fast-forward for one machine (the machine calls the hooks; it reads the machine)."""
+
+    def __init__(self, machine: Machine, mode: FastForward):
+        self.machine = machine
+        self.mode = mode
+        # what it must know of a pass: what it emitted, or only whether it emitted anything
+        self.shape = ff.shape if mode is FastForward.ALL else ff.silent
+        self.anchors = Anchors()
+        self.log: list = []  # effects since log_base: what passes emitted (fastforward.shape)
+        self.log_base = 0
+        self.horizon = INF  # the end of the run: it bounds a jump (skippable)
+        self.waits = 0  # wait commands executed (a loop without any is a busy loop)
+        self.inputs = 0  # input changes (a pass that sees one does not repeat)
+
+    # ------------------------------------------------------------ hooks: the machine says
+    def running_to(self, until: int) -> None:
+        self.horizon = until
+
+    def code_changed(self) -> None:
+        """Macros were loaded, stored or erased, or the machine powered on: no visit holds."""
+        self.anchors.visits.clear()
+
+    def macro_entered(self, slot: int) -> None:
+        """Its entry is a loop anchor (a macro may call itself, or goto round a ring)."""
+        self.anchors.forget_slot(slot)
+        self._arrive(Anchor(Loop.EM, slot), None, INF)
+
+    def loop_jumped(self, slot: int, ip: int, remaining: float) -> None:
+        """The RP at `ip` jumped back, with `remaining` passes left after this one."""
+        self._arrive(Anchor(Loop.RP, slot, ip), ip, remaining)
+
+    def loop_ended(self, slot: int, ip: int) -> None:
+        self.anchors.visits.pop(Anchor(Loop.RP, slot, ip), None)
+
+    def wait_begun(self) -> None:
+        self.waits += 1
+
+    def input_changed(self) -> None:
+        self.inputs += 1
+
+    def emitted(self, event: object) -> None:
+        """An event the listeners heard: a pass's effects are all but its control flow (which
+        repeats with it), and the inner skips that emitted something."""
+        if type(event) is ev.FastForwarded:
+            if event.shape:
+                self.log.append(event)
+        elif not isinstance(event, FLOW):
+            self.log.append(event)
+
+    def move_requested(self, target: int) -> None:
+        """A move asked for `target`, clamped to the soft range it was asked in."""
+        self.log.append(ff.Requested(target, *self.machine.axis.soft_range()))
+
+    def profile_starting(self) -> None:
+        """A profile starts; one that does not start from rest on a count does not shift."""
+        if not self.machine.axis.at_rest_on_count():  # floats would differ
+            self.log.append(Note.UNSHIFTABLE)
+
+    def reported(self, mnemonic: str) -> None:
+        """Note how the report just made depends on the position (fastforward.moved_shape)."""
+        if mnemonic not in POSITIONAL:
+            return
+        axis = self.machine.axis
+        if mnemonic == Mnemonic.TT:
+            self.log.append(ff.Shows(COMMANDS[mnemonic].report, axis.target))
+        elif not axis.at_rest_on_count():
+            self.log.append(Note.UNSHIFTABLE)
+        elif mnemonic == Mnemonic.TS:
+            self.log.append(Note.SWITCHES)
+        elif mnemonic in (Mnemonic.TP, Mnemonic.TD):
+            self.log.append(ff.Shows(COMMANDS[mnemonic].report, int(axis.final)))
+
+    def trigger_set(self) -> None:
+        """ZM, ZP or ZI: pulses at positions are not counted as boundaries."""
+        if self.machine.trigger.mode:
+            self.log.append(Note.UNSHIFTABLE)
+
+    def pulsed(self) -> None:
+        self.log.append(Note.UNSHIFTABLE)
+
+    # ------------------------------------------------------------ at a loop anchor
+    def _arrive(self, anchor: Anchor, own: int | None, remaining: float) -> None:
+        """A loop came round: report a busy loop, skip identical passes (fastforward.py)."""
+        previous = self.anchors.visits.get(anchor)
+        key = self._key(own)
+        if previous is not None and self.waits == previous.waits and remaining >= BUSY_PASSES:
+            self._busy_loop(anchor, key, previous)
+        visit = self._visit(key, previous)
+        self.anchors.visits[anchor] = visit
+        if previous is None or self.mode is FastForward.OFF:
+            return
+        if not ff.same_pass(previous, visit):
+            if self.mode is FastForward.ALL and ff.same_shifted_pass(previous, visit):
+                self._skip_shifted(anchor, own, previous, visit, remaining)
+            return
+        if visit.shape and self.mode is not FastForward.ALL:
+            return
+        passes = ff.skippable(previous, visit, self._bound(), remaining)
+        if passes > 0:
+            self._jump(Jump(anchor, own, passes, visit.wake - previous.wake, visit.shape,
+                            visit.position, 0), visit)
+
+    def _skip_shifted(self, anchor: Anchor, own: int | None, previous: Visit, visit: Visit,
+                      remaining: float) -> None:
+        """Skip passes that repeat `visit.delta` further on, up to the next boundary."""
+        period = visit.wake - previous.wake
+        fit = ff.skippable(previous, visit, self._bound(), remaining)
+        axis = self.machine.axis
+        passes = ff.shifted_passes(visit, period, fit, axis.soft_range(), axis.switches())
+        if passes < fit:  # a boundary, not the counter, ends it: enclosing passes differ
+            self.log.append(Note.UNSHIFTABLE)
+        if passes > 0:
+            self._jump(Jump(anchor, own, passes, period, visit.moved, visit.position,
+                            visit.delta), visit)
+
+    def _jump(self, jump: Jump, visit: Visit) -> None:
+        """Have the machine jump, then arrive again: the jump's own event belongs to enclosing
+        loops, not to the next pass."""
+        self.machine._jump(jump)
+        key = self._key(jump.own)
+        skey, position = self._shift_key(key)
+        self.anchors.visits[jump.anchor] = Visit(key, self.machine.wake, self.inputs, self.waits,
+                                         self.log_base + len(self.log), visit.shape,
+                                         skey, position, visit.delta, visit.moved)
+
+    def _bound(self) -> float:
+        """What a jump must stop before: the end of the run or the next hardware event."""
+        return min(self.horizon, self.machine._next_hardware())
+
+    def _busy_loop(self, anchor: Anchor, key: tuple | None, previous: Visit) -> None:
+        """A long pass without a wait came round: a busy loop, if it is a loop. Reported
+        once; it ends the pass, so that pass is not skipped (a loop is skipped after two
+        passes without a new hazard, as plain stepping would report none in the passes
+        skipped)."""
+        if anchor.loop is Loop.RP or (key is not None and key == previous.key):
+            self.machine._busy_loop(anchor)
+
+    def _visit(self, key: tuple | None, previous: Visit | None) -> Visit:
+        """This arrival at an anchor, with what the pass since `previous` emitted."""
+        if len(self.log) > LOG_LIMIT:  # passes this long are not compared
+            self.log_base += len(self.log)
+            self.log.clear()
+        pass_shape = moved = delta = None
+        whole = (previous is not None and previous.logged >= self.log_base
+                 and self.mode is not FastForward.OFF)  # which compares no passes
+        if whole and key is not None and key == previous.key:
+            pass_shape = self.shape(self.log[previous.logged - self.log_base:], previous.wake)
+        skey, position = self._shift_key(key)
+        if (whole and pass_shape is None and skey is not None and skey == previous.skey
+                and self.mode is FastForward.ALL):
+            delta = position - previous.position
+            moved = ff.moved_shape(self.log[previous.logged - self.log_base:],
+                                   previous.wake, previous.position)
+        return Visit(key, self.machine.wake, self.inputs, self.waits,
+                     self.log_base + len(self.log), pass_shape, skey, position, delta, moved)
+
+    def _key(self, own: int | None) -> tuple | None:
+        """The machine's state key (Machine.STATE_KEY); None while the axis moves."""
+        m = self.machine
+        if m.axis.segs or m.axis.moving(m.clock.now):
+            return None
+        return m._state_key(own)
+
+    def _shift_key(self, key: tuple | None) -> tuple[tuple | None, int]:
+        """The state key without the axis's position and target, and the target; (None, 0)
+        unless the axis rests on its target, a whole count, with no trigger set."""
+        m = self.machine
+        if key is None or m.axis.final != m.axis.target or m.trigger.mode:
+            return None, 0
+        return m.unshifted(key), m.axis.target

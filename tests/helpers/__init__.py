@@ -1,0 +1,21 @@
+"""What tests share, one module per noun; fixtures and hooks stay in tests/conftest.py.
+
+    paths        the repository's folders and each example file by name
+    compiling    compile a snippet: its rules, its program
+    cli          run `mercmac` in-process (click) or as a process; its exit codes; a hang guard
+    files        what a whole-or-nothing write leaves behind
+    simulation   a simulation run as plain data, to compare two runs
+    emulator     the virtual controller on a pty, and the short timeouts to talk to it
+    lsp_wire     a real `mercmac lsp` fed raw bytes
+    semantics    a model of the firmware and of the structured program, to compare traces
+    programs     random well-formed programs (Hypothesis strategies)
+    readme       the README's code blocks, commands and tour program
+    budgets      Hypothesis profiles (dev, ci, thorough) and example budgets
+
+Test files import them as `from helpers.cli import cli`. pyproject's `pythonpath` puts tests/
+(never the root of this tree) on sys.path, and pytest puts conftest.py's folder there too, so
+`helpers` resolves from any folder below tests/ and in every pytest-xdist worker. tests/ is no
+package and the root is not on the path so that a test of this tree run against an older
+checkout (`cd /tmp/base && PYTHONPATH=/tmp/base python -m pytest /work/main/tests/test_x.py`,
+which still reads this tree's pyproject) imports that checkout's mercmac, not this one's.
+"""

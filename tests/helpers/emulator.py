@@ -1,0 +1,59 @@
+"""The virtual controller on a real pseudo-terminal, and how tests talk to it."""
+from __future__ import annotations
+
+import time
+from contextlib import contextmanager
+
+import serial
+
+from mercmac.emulator.ptyserver import PtyServer
+from mercmac.emulator.virtual import Faults, VirtualController
+from mercmac.upload.connect import open_controller
+from mercmac.upload.transport import Timing
+
+# Short waits: the suite stays fast, and never hangs. FAST_TIMING for the library,
+# FAST for the command line (`--timeout`): the same answer timeout.
+FAST_TIMING = Timing(timeout=0.3, settle=0.05)
+FAST = ("--timeout", str(FAST_TIMING.timeout))
+
+
+@contextmanager
+def serve(**kw):
+    """A virtual controller on a pty: yields (server, controller)."""
+    faults = kw.pop("faults", None) or Faults()
+    vc = VirtualController(faults=faults, **kw)
+    with PtyServer(vc) as server:
+        yield server, vc
+
+
+@contextmanager
+def connect(server, address: int = 0, timing: Timing = FAST_TIMING):
+    with open_controller(server.path, address, timing=timing) as c:
+        yield c
+
+
+@contextmanager
+def raw_port(server):
+    """pyserial straight on the pty, for byte-level checks."""
+    port = serial.serial_for_url(server.path, baudrate=9600, timeout=0.3)
+    try:
+        yield port
+    finally:
+        port.close()
+
+
+def eventually(server, check, seconds: float = 1.0) -> bool:
+    """Whether check(controller) becomes true: the emulator reads bytes in its own thread."""
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if server.call(check):
+            return True
+        time.sleep(0.005)
+    return False
+
+
+def read_for(port, seconds: float = 0.15) -> bytes:
+    end, data = time.monotonic() + seconds, b""
+    while time.monotonic() < end:
+        data += port.read(port.in_waiting or 1)
+    return data

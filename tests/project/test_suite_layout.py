@@ -1,0 +1,92 @@
+"""The suite's own layout (issue 17 §5): what tests share lives in tests/helpers/, fixtures
+and hooks in conftest.py, files are found through helpers.paths (so a test file can move
+to another folder and still run), and every Hypothesis budget follows the chosen profile."""
+from __future__ import annotations
+
+import ast
+import os
+import subprocess
+import sys
+
+import pytest
+
+from helpers import budgets
+from helpers.paths import ROOT, TESTS
+
+TEST_FILES = sorted(TESTS.rglob("test_*.py"))
+
+
+def _tree(path) -> ast.Module:
+    return ast.parse(path.read_text(encoding="utf-8"))
+
+
+def _imported(tree: ast.Module) -> list[str]:
+    return [n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module] + \
+        [a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names]
+
+
+@pytest.mark.parametrize("path", TEST_FILES, ids=lambda p: str(p.relative_to(TESTS)))
+def test_shared_code_comes_from_helpers_and_a_test_imports_only_its_neighbours(path):
+    # conftest, `tests.x` and a test module of another folder resolve only from some places
+    # (tests/ itself, the root as the current folder, the order of collection)
+    wrong = [m for m in _imported(_tree(path))
+             if m in ("conftest", "lsp_wire", "semantics") or m.split(".")[0] == "tests"
+             or (m.startswith("test_") and not (path.parent / f"{m}.py").exists())]
+    assert not wrong, f"{path.name} imports {wrong}: import helpers.* (or a test of its own folder)"
+
+
+@pytest.mark.parametrize("path", TEST_FILES, ids=lambda p: str(p.relative_to(TESTS)))
+def test_files_are_found_through_the_helpers_paths(path):
+    # a bare __file__ (not mercmac.__file__): a path from the test's own folder
+    lines = [n.lineno for n in ast.walk(_tree(path)) if isinstance(n, ast.Name) and n.id == "__file__"]
+    assert not lines, f"{path.name}:{lines} finds files from its own folder: use helpers.paths"
+
+
+def test_conftest_holds_only_fixtures_and_hooks():
+    def is_fixture(node) -> bool:
+        return any("fixture" in ast.unparse(d) for d in node.decorator_list)
+
+    defined = [n for n in _tree(TESTS / "conftest.py").body
+               if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef))]
+    others = [n.name for n in defined if not n.name.startswith("pytest_") and not is_fixture(n)]
+    assert defined and not others, f"conftest.py defines {others}: move them to tests/helpers/"
+
+
+@pytest.mark.parametrize("path", TEST_FILES, ids=lambda p: str(p.relative_to(TESTS)))
+def test_every_example_budget_follows_the_profile(path):
+    fixed = [node.lineno for node in ast.walk(_tree(path)) if isinstance(node, ast.Call)
+             and ast.unparse(node.func).endswith("settings")
+             for k in node.keywords if k.arg == "max_examples" and isinstance(k.value, ast.Constant)]
+    assert not fixed, f"{path.name}:{fixed}: max_examples=budget(N), so `thorough` searches longer"
+
+
+@pytest.mark.parametrize("environment, profile", [
+    ({}, "dev"),
+    ({"CI": "true"}, "ci"),
+    ({"CI": "true", budgets.VARIABLE: "thorough"}, "thorough"),
+    ({budgets.VARIABLE: "ci"}, "ci"),
+])
+def test_the_profile_is_dev_locally_ci_under_ci_or_the_one_asked_for(environment, profile,
+                                                                     monkeypatch):
+    for name in ("CI", budgets.VARIABLE, "MERCMAC_FUZZ_EXAMPLES"):
+        monkeypatch.delenv(name, raising=False)
+    for name, value in environment.items():
+        monkeypatch.setenv(name, value)
+    assert budgets.chosen() == profile
+    assert budgets.budget(30) == (300 if profile == "thorough" else 30)
+
+
+def test_mercmac_fuzz_examples_still_sets_a_fuzz_budget(monkeypatch):
+    monkeypatch.setenv("MERCMAC_FUZZ_EXAMPLES", "7")
+    assert budgets.fuzz_budget(40) == 7
+
+
+@pytest.mark.slow
+def test_an_unknown_profile_stops_pytest_naming_the_choices():
+    env = {**os.environ, budgets.VARIABLE: "fast"}
+    run = subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "--collect-only",
+                          "tests/project/test_readme.py"], cwd=ROOT, env=env, capture_output=True,
+                         text=True, timeout=120)
+    assert run.returncode == 4, run.stdout[-2000:] + run.stderr[-2000:]  # pytest: usage error
+    assert f"{budgets.VARIABLE}='fast'" in run.stderr and "dev, ci, thorough" in run.stderr
+    assert "Traceback" not in run.stderr
