@@ -21,6 +21,11 @@ Loops whose passes differ by a constant shift of position and target (issue 11,
 item 3), 1500 simulated days each (goal: under 2 s of wall time each):
 (f) `every 10ms { MR 1, WS 0 }`: a scan stepping forever (into the soft limit);
 (g) Example 4 in mode 1 with button 1 held from power-on (`--buttons 1@0`).
+
+A rig (issue 18 §3, goal: at most 2 s of wall time):
+(h) the raster example (examples/rigs/raster/), one simulated hour from button 1 on X:
+    both controllers on one clock, joint fast-forward on; then in-process, the same hour
+    stepped (joint fast-forward off) for the ratio.
 """
 from __future__ import annotations
 
@@ -57,6 +62,11 @@ SHIFT_CASES = {
     "every 10ms { MR 1, WS 0 } to 1500d": lambda: measure_source(JOG, LONG_MS),
     "example 4, mode 1, button 1 held, 1500d": lambda: measure(
         [EXAMPLE4, "--buttons", "1@0", "--until", "1500d"]),
+}
+RASTER = os.path.join(HERE, "..", "examples", "rigs", "raster", "raster.rig.toml")
+RIG_CASES = {
+    "raster rig, 1 h from button 1 on x": (
+        [os.path.abspath(RASTER), "--buttons", "x:1@0-100ms", "--until", "1h"], HOUR_MS),
 }
 # (source, simulated ms, simulated ms with --short)
 DAY_CASES = {
@@ -109,6 +119,21 @@ def presses_at_one_instant(count: int) -> float:
     return time.perf_counter() - start
 
 
+def raster_stepped(until_ms: int) -> float:
+    """Wall seconds of the raster rig stepped instant by instant (no joint fast-forward)."""
+    from mercmac.rig.checks import compile_rig
+    from mercmac.rig.load import read_rig
+    from mercmac.sim.rig import simulate_rig
+    from mercmac.timespec import parse_buttons
+
+    rig = read_rig(RASTER).rig
+    programs = {name: c.program for name, c in compile_rig(rig).items()}
+    start = time.perf_counter()
+    simulate_rig(rig, programs, presses={"x": parse_buttons("1@0-100ms")}, until_ms=until_ms,
+                 fast_forward=False)
+    return time.perf_counter() - start
+
+
 def main() -> None:
     short = "--short" in sys.argv[1:]
     for name, (source, day_ms, short_ms) in DAY_CASES.items():
@@ -127,6 +152,13 @@ def main() -> None:
         final = result["final"]
         print(f"{name}: simulated {LONG_MS / 1000:,.0f} s in {wall:.2f} s wall "
               f"-> ratio {LONG_MS / 1000 / wall:,.0f} : 1 (position {final['position']:,})")
+    for name, (args, simulated_ms) in RIG_CASES.items():
+        wall, result = measure(args)
+        y = result["controllers"]["y"]["final"]
+        stepped = raster_stepped(simulated_ms)
+        print(f"{name}: simulated {simulated_ms / 1000:,.0f} s in {wall:.2f} s wall "
+              f"-> ratio {simulated_ms / 1000 / wall:,.0f} : 1 (y at {y['position']:,}; "
+              f"stepped in-process: {stepped:.2f} s)")
     for name, (args, simulated_ms) in CASES.items():
         wall, result = measure(args)
         simulated = simulated_ms if simulated_ms is not None else result["ended_ms"]

@@ -319,6 +319,133 @@ remove the comment. Only `check` reads these comments.""", {
         "empty": "`mercmac: ignore[]` names no rule, so it turns nothing off: name the rules, "
                  "or write `// mercmac: ignore` for every rule on the line",
     }),
+    # -- rigs (issue 18, SPEC §6): the rig file, checked by mercmac/rig/checks.py --
+    Rule("MR001", "rig-file", _E, "the rig file cannot be read as a rig", """\
+A rig file (`NAME.rig.toml`) is UTF-8 TOML with the keys the README's "Rigs"
+section lists: `name`, `box`, `box_buttons`, `wires`, a `[joystick]` table and
+one `[controllers.NAME]` table per controller with `address`, `model` and
+`program`. A key mercmac does not know is refused rather than passed over, so
+a misspelled `adress` cannot silently leave a controller at a default. Fix the
+text at the position given.""", {
+        "toml": "not TOML: {error}",
+        "unknown": "unknown key '{key}' {where}; the keys are {keys}",
+        "missing": "{where} needs '{key}'",
+        "type": "'{key}' {where} must be {expects}",
+        "empty": "the rig names no controller: add a [controllers.NAME] table per controller",
+        "name": "'{name}' is no controller name: write a letter or '_' then letters, digits "
+                "or '_' (x, stage_1)",
+        "unknown-controller": "{where} names '{name}', which is no controller of the "
+                              "rig{hint}",
+        "branch": "the joystick has no branch '{branch}': its branches are X, Y and Z "
+                  "(MS176E §3.6)",
+        "button": "the C-170.PB box has no button {button}: its buttons are 1-4 on inputs 1-4",
+    }),
+    Rule("MR002", "rig-program", _E, "a controller's program cannot be read", """\
+Each controller's `program` is a `.mcm` path relative to the rig file. The
+rig is checked, simulated and flashed as a whole, so a program that is missing
+or unreadable stops all of it; the message says why the file could not be
+read.""", {"": "the program of {controller} cannot be read: {why}"}),
+    Rule("MR003", "rig-wire", _E, "a wire that is not OUTPUT -> INPUT", """\
+A wire joins an output line of one controller to an input line of another:
+`"x.out1 -> y.in1"` (or `→`). A Mercury has 4 digital outputs and 4 inputs
+(MS176E §4.5.1); output 4 is also the trigger output (§4.5.2). A wire starts at
+an output (`out1`-`out4`) and ends at an input (`in1`-`in4`) of a different
+controller: inputs 5 and 6 are the joystick and its button (§6.4 XN), which
+no wire reaches.""", {
+        "syntax": "a wire is written \"NAME.outN -> NAME.inN\" (e.g. \"x.out1 -> y.in1\"), "
+                  "found {text}",
+        "line": "{line}: {kind} lines are numbered 1-4 (MS176E §4.5.1)",
+        "direction": "a wire runs from an output to an input: {wire}",
+        "loop": "{wire} joins a controller to itself: a program knows its own outputs",
+    }),
+    Rule("MR004", "address-range", _E, "a controller address outside 0-15", """\
+The address of a controller is set with DIP switches 1 to 4 (MS176E §3.1.3,
+§3.2): 16 combinations, addresses 0-15, selected on the link by the code
+\\x01 and one hex digit. Any other number can never be selected. Set the
+address the switches give.""", {"": "address {address} is out of range: the DIP switches "
+                                    "give 0-15 (MS176E §3.2)"}),
+    Rule("MR005", "address-repeated", _E, "two controllers of a rig share an address", """\
+Every controller of a daisy chain compares the address selection code with its
+own DIP-switch address and answers when they match (MS176E §3.2). Two
+controllers with one address both answer at once and garble each other's
+replies, and a flash would write both with one program. Give each its own
+address.""", {"": "{controller} has address {address}, as {other} has: each controller of a "
+                  "chain needs its own (MS176E §3.2)"}),
+    Rule("MR006", "model-mismatch", _E, "a program's target differs from its controller's model", """\
+A program states the model it was written for (`target C-663`), and the rig
+says which model each controller is. They must agree: the C-663 drives
+steppers and the C-863 DC servos, with different commands, ranges and
+power-on defaults (MS176E §3.4, §6.2). The program is checked with the rig's
+model; fix whichever of the two is wrong.""", {
+        "": "{controller} is a {model} in the rig, but its program targets {target}"}),
+    Rule("MR007", "select-networked", _E, "SC in an autostart macro of a rig of several controllers", """\
+SCn in the autostart macro (macro 0) selects the controller at power-on
+without an address selection code (MS176E §3.1.2), for a single controller
+whose host cannot send the \\x01 byte. The manual says "This method can not be
+used with networked controllers": on a chain every controller selecting
+itself at once answers together with the others. Remove SC from macro 0 and
+let the host send address selection codes.""", {
+        "": "SC in macro 0 of {controller}: \"can not be used with networked controllers\" "
+            "(MS176E §3.1.2), and this rig has {count}"}),
+    Rule("MR008", "input-driven-twice", _E, "an input line driven by two sources", """\
+An input line reads one TTL level. Two outputs wired to it, or a wire and a
+button of the C-170.PB box (which applies its own TTL signals to the input
+lines, MS176E §4.5.1), fight over it: the level the program reads depends on
+which drives harder, and a pressed button may short an output. Drive each
+input from one place; leave the button out of `box_buttons` if the box's
+button is not connected.""", {
+        "wire": "{line} is driven by {first} and by {second}",
+        "button": "{line} is driven by {wire} and by button {button} of the C-170.PB box",
+    }),
+    Rule("MR009", "output-never-set", _W, "a wire from an output its program never sets", """\
+A wire carries an output line's level to another controller (MS176E §4.5.1:
+"interaxis communication" in stand-alone mode). The program of the
+controller the wire starts at never sets that output (no CN, CF, CP or trigger
+mode ZM for output 4, §4.5.2), so the wire always carries OFF and whatever
+waits on it at the other end waits for good. Set the output in the program, or
+wire the output that the program does set.""", {
+        "": "{wire}: the program of {controller} never sets output {number} (no CN/CF/CP)"}),
+    Rule("MR010", "input-undriven", Severity.INFO, "a program reads an input nothing drives", """\
+The program waits on or tests an input line (WN, WF, XN or XF, MS176E §4.5.1)
+that no wire of the rig and no button of the C-170.PB box drives, so on the
+rig it reads a constant level. That is right when something outside the rig
+(a sensor, a switch) is connected there; otherwise add the wire, or name the
+box on this controller.""", {
+        "": "{controller} reads input {number} ({command}), which no wire or box button "
+            "of the rig drives"}),
+    Rule("MR011", "wait-cycle", _W, "controllers that wait on each other before either sets its line", """\
+Controller A waits (WN) for an input wired from an output of B, while B
+only raises that output after it has itself waited for an input wired from
+A, which A raises only after its own wait: each waits for the other and
+neither moves - a dead-lock the simulator shows as well (MS176E §4.5.1
+interaxis I/O). Over three or more controllers the waits may go round the
+same way.
+The check is a static approximation: it reads each program in run order
+from the autostart macro (each macro where it is first called or jumped to)
+and takes a wait as "before" a raise (CN, a CP pattern with the line's bit,
+ZM for output 4) when it comes first on that path. WF is not counted: the
+lines start OFF, so a WF on a line no one has raised passes at once. It does
+not follow which way an XN/XF goes, nor a second pass of a loop, so a cycle
+that a button or a branch breaks is still reported, and a dead-lock that
+needs a loop to turn round, or a WF on a line left high, is not. Let one
+side raise its output first (in the autostart macro), or run `mercmac sim`
+on the rig to see the run.""", {
+        "": "{first} waits for {first_line} before raising {first_out}, and {second} waits "
+            "for {second_line} before raising {second_out}: each waits for the other"}),
+    Rule("MR012", "joystick-branch", _E, "a joystick wired in a way it cannot work", """\
+A C-819.20 joystick drives two controllers through its Y-cable, and a
+C-819.30 three through separate cables (MS176E §3.6.1). "If the Y-cable is
+used to connect a joystick to two controllers, the X-branch must be connected
+to a powered-up controller because joystick power is taken from that side":
+a Y branch without an X branch leaves the joystick without power. And a
+controller has one joystick socket, so two branches cannot go to one
+controller. Name the X branch's controller in `[joystick]`, one branch per
+controller.""", {
+        "power": "the joystick's Y branch goes to {controller}, but no controller has its X "
+                 "branch: the Y-cable takes the joystick's power from the X side (MS176E §3.6.1)",
+        "socket": "branches {first} and {second} both go to {controller}, which has one "
+                  "joystick socket (MS176E §3.6.1)",
+    }),
 )
 
 _BY_KEY = {r.code: r for r in RULES} | {r.name: r for r in RULES}

@@ -38,7 +38,8 @@ def test_hazard_is_found(name, text, options):
 
 
 def test_every_hazard_is_tested_and_explained():
-    assert {name for name, _, _ in HAZARDS} == set(hazards.NAMES)
+    # rig-deadlock needs several controllers: tests/sim/test_rig_sim.py finds it on a rig
+    assert {name for name, _, _ in HAZARDS} | {"rig-deadlock"} == set(hazards.NAMES)
     for r in hazards.RULES:
         assert r.code.startswith("MH") and len(r.explanation) > 100, r.name
 

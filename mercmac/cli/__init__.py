@@ -108,6 +108,10 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
           limit: int | None, fix: bool, diff: bool) -> None:
     """Check .mcm files, or every .mcm file below a folder, against the firmware's rules.
 
+    A rig file (NAME.rig.toml: several controllers on one chain, README "Rigs") is checked
+    as a whole: the file itself, the rig rules (MR...), and each program with its
+    controller's model.
+
     Settings (target, select, ignore) come from `[tool.mercmac]` in pyproject.toml or
     from mercmac.toml, found upward from each file; options override them.
     `// mercmac: ignore[RULE, ...]` on a line turns those rules off there.
@@ -130,7 +134,7 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
         results, found = [], []
         for f in paths:
             try:
-                findings = _check_file(f, chosen, fixes)
+                checked = _check_file(f, chosen, fixes)
             except OSError as e:
                 from mercmac.outfile import reason
                 from mercmac.render.report import printable
@@ -138,8 +142,8 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
                 say(f"cannot read {printable(f)}: {reason(e)}")
                 unreadable += 1
                 continue
-            results.append(findings.compilation)
-            found += findings.diagnostics
+            results += [findings.compilation for findings in checked]
+            found += [d for findings in checked for d in findings.diagnostics]
         if not results:
             return EXIT_USAGE
         if fixes is not None:
@@ -186,17 +190,33 @@ def _fixes(files: tuple[str, ...], fix: bool, diff: bool):
     return Fixes(diff)
 
 
-def _check_file(path: str, chosen, fixes=None):
-    """What `check` reports on one file: the language server's check (mercmac.compiler.checking),
-    after the file is fixed when `fixes` (--fix, --diff)."""
+def _check_file(path: str, chosen, fixes=None) -> list:
+    """What `check` reports on one file, as Findings per file checked: the language server's
+    check (mercmac.compiler.checking), after the file is fixed when `fixes` (--fix, --diff);
+    for a rig file its own findings and its programs' (mercmac.rig.checks)."""
     from mercmac.compiler import checking
     from mercmac.errors import SettingsError
     from mercmac.render.report import printable
+    from mercmac.rig.load import is_rig_path
 
     try:
-        return fixes.file(path, chosen) if fixes is not None else checking.check_file(path, chosen)
+        if is_rig_path(path):
+            return _check_rig(path, chosen, fixes)
+        return [fixes.file(path, chosen) if fixes is not None else checking.check_file(path, chosen)]
     except SettingsError as e:  # it names a settings file, whose path may hold any character
         raise SettingsError(printable(e.message), hint=e.hint) from None
+
+
+def _check_rig(path: str, chosen, fixes) -> list:
+    """A rig file's findings and its programs' (mercmac.rig.checks); --fix takes .mcm files."""
+    from mercmac.cli.common import UsageError
+    from mercmac.render.report import printable
+    from mercmac.rig.checks import check_rig_path
+
+    if fixes is not None:
+        raise UsageError(f"--fix and --diff take .mcm files, and {printable(path)} is a rig file",
+                         hint="give the rig's programs to fix them")
+    return check_rig_path(path, chosen)
 
 
 def _show(found, results, fmt: str, statistics: bool, limit: int | None) -> None:
@@ -310,6 +330,9 @@ def commands_command(words: tuple[str, ...], model: str | None) -> None:
 def fmt_command(files: tuple[str, ...], check: bool, diff: bool) -> None:
     """Write .mcm files (or every .mcm below a folder) in the one canonical layout;
     the build never changes.
+
+    A rig file (`NAME.rig.toml`) stands for the programs of its controllers; the rig
+    file itself is left as written.
 
     `-` formats standard input to standard output. Exit 0 when done (or, with
     --check/--diff, when nothing would change), 1 when a file would change,

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import difflib
+import sys
 
 import click
 
@@ -12,8 +13,9 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK, EXIT_USAGE
 def format_files(files: tuple[str, ...], *, check: bool, diff: bool) -> int:
     """Format FILES; the exit code (SPEC §5): 2 if any could not be done, else 1 if
     --check/--diff found one that would change, else 0."""
-    changed = unchanged = failed = 0
-    for path in files:
+    paths, failed = _programs(files)
+    changed = unchanged = 0
+    for path in paths:
         outcome = _one(path, check=check, diff=diff)
         if outcome is None:
             failed += 1
@@ -25,6 +27,51 @@ def format_files(files: tuple[str, ...], *, check: bool, diff: bool) -> int:
     if failed:
         return EXIT_USAGE
     return EXIT_FAILED if changed and (check or diff) else EXIT_OK
+
+
+def _programs(files: tuple[str, ...]) -> tuple[list[str], int]:
+    """FILES with each rig file (`*.rig.toml`, SPEC §6) in the place of its programs, and
+    how many rig files could not be read (each said). The rig file itself is TOML that
+    the user wrote: fmt leaves it as written."""
+    import os
+
+    from mercmac.rig.load import is_rig_path
+
+    rigs = [path for path in files if is_rig_path(path)]
+    if not rigs:
+        return list(files), 0
+    out, failed = {}, 0  # real path -> as named: a program named twice is formatted once
+    for path in files:
+        programs = _rig_programs(path) if path in rigs else [path]
+        if programs is None:
+            failed += 1
+            continue
+        if path in rigs:
+            say(f"{path}: formatting the programs of its {len(programs)} controller"
+                f"{'s' * (len(programs) != 1)}; the rig file itself is left as written")
+        for program in programs:
+            out.setdefault(program if program == "-" else os.path.realpath(program), program)
+    return list(out.values()), failed
+
+
+def _rig_programs(path: str) -> list[str] | None:
+    """The program files of the rig at PATH, or None when the rig cannot be read (said)."""
+    from mercmac.rig.load import read_rig
+    from mercmac.render import report as render
+
+    try:
+        rig_file = read_rig(path)
+    except OSError as e:
+        from mercmac import outfile
+
+        say(f"cannot read {path}: {outfile.reason(e)}")
+        return None
+    if rig_file.rig is None:
+        render.write_text(rig_file.report.items, {rig_file.source.name: rig_file.source}, 1,
+                          sys.stderr)
+        say(f"cannot format the programs of {path}: the rig file has errors")
+        return None
+    return [c.program for c in rig_file.rig.controllers]
 
 
 def _one(path: str, *, check: bool, diff: bool) -> bool | None:

@@ -149,7 +149,10 @@ def _guarded(work) -> None:
 @click.option("-o", "--output", type=click.Path(dir_okay=False, allow_dash=True),
               callback=file_name, help="Write the source to this file instead of standard output.")
 @click.option("--force", is_flag=True, help="Write the source even over FILE itself.")
-def decompile(file, port, address, baud, timeout, output, force) -> None:
+@click.option("--rig", "rig_dir", type=click.Path(file_okay=False), callback=file_name,
+              help="With --port: scan the chain and write a rig folder, DIR/NAME.rig.toml and "
+                   "each controller's source (as `pull --rig`, decompiled).")
+def decompile(file, port, address, baud, timeout, output, force, rig_dir) -> None:
     """Turn raw macros back into high-level source that builds to exactly the same macros.
 
     FILE is a .mcm file of `[MCnn]` blocks (a pull, a backup); --port reads the
@@ -160,6 +163,8 @@ def decompile(file, port, address, baud, timeout, output, force) -> None:
     be opened.
     """
     def work() -> int:
+        if rig_dir is not None:
+            return _decompile_rig(file, port, output, rig_dir, baud, timeout)
         if not force:
             _not_the_input(file, output)  # refused before a port is read
         read = _read(file, port, address, baud, timeout)
@@ -172,6 +177,28 @@ def decompile(file, port, address, baud, timeout, output, force) -> None:
         return EXIT_OK
 
     _guarded(work)
+
+
+def _decompile_rig(file, port, output, rig_dir: str, baud: int, timeout: float) -> int:
+    """`decompile --port PORT --rig DIR`: `pull --rig` with decompiled sources (a program
+    mercmac flashed comes back as its recorded source)."""
+    from mercmac.cli.upload import pull_rig, rig_folder
+
+    if file is not None or port is None:
+        raise UsageError("--rig reads a chain: give --port PORT and no FILE",
+                         hint="mercmac decompile --port PORT --rig DIR")
+    given = click.get_current_context().get_parameter_source("address")
+    folder = rig_folder(rig_dir, output=output,
+                        address=None if given is click.core.ParameterSource.DEFAULT else 0)
+
+    def text_of(m):
+        if m.record:
+            return m.record.source, "recorded source"
+        text = _library().decompile(m.pulled.macros, model=m.model,
+                                    origin=f"{port}, address {m.address}")
+        return (text if text.endswith("\n") or not text else text + "\n"), "decompiled"
+
+    return pull_rig(port, folder, baud, timeout, text_of)
 
 
 @click.command()
@@ -187,14 +214,23 @@ def describe(file, port, address, baud, timeout, fmt, graph) -> None:
     FILE is a .mcm file; --port reads the controller instead. Macros have the names
     the source gives them (on --port: the source `mercmac flash` recorded, when the
     controller holds exactly its build), else names made from what they do.
+    A rig file (`NAME.rig.toml`) is described as a whole: each controller's program
+    under its name and address, what each wire carries, and with --graph one picture
+    with a cluster per controller and the wires between them.
     """
     def work() -> int:
         graph_kind = _graph_kind(graph) if graph is not None else None  # before the port is read
-        read = _named(_read(file, port, address, baud, timeout))
         library = _library()
-        text = library.describe(read.macros, model=read.model, fmt=fmt, names=read.names)
+        if file and not port and _is_rig(file):
+            rig, programs = _rig_programs(file)
+            text = library.describe_rig(rig, programs, fmt)
+            dot = library.rig_graph_dot(rig, programs) if graph is not None else None
+        else:
+            read = _named(_read(file, port, address, baud, timeout))
+            text = library.describe(read.macros, model=read.model, fmt=fmt, names=read.names)
+            dot = None if graph is None else library.call_graph_dot(
+                read.macros, model=read.model, names=read.names)
         if graph is not None:
-            dot = library.call_graph_dot(read.macros, model=read.model, names=read.names)
             _write_graph(dot, graph, graph_kind)
         click.echo(text, nl=not text.endswith("\n"))
         if graph is not None:
@@ -202,6 +238,28 @@ def describe(file, port, address, baud, timeout, fmt, graph) -> None:
         return EXIT_OK
 
     _guarded(work)
+
+
+def _is_rig(path: str) -> bool:
+    from mercmac.rig.load import is_rig_path
+
+    return is_rig_path(path)
+
+
+def _rig_programs(path: str):
+    """The rig at PATH and each controller's program as it would be stored
+    (decompile.Stored, by controller name); _Refused when the rig file or a program has
+    errors (shown as `check` shows them), as `sim RIG` refuses them."""
+    from mercmac.cli.run_rig import _compile, _load
+    from mercmac.decompile import Stored
+
+    rig = _load(path)  # UsageError (exit 2) when it cannot be read
+    programs = None if rig is None else _compile(rig)
+    if programs is None:
+        raise _Refused()
+    return rig, {c.name: Stored({m.slot: m.line for m in programs[c.name].macros.values()},
+                                c.model, programs[c.name].names())
+                 for c in rig.controllers}
 
 
 def _graph_kind(path: str) -> str:

@@ -38,6 +38,7 @@ class Request:
     verbose: int = 0  # timeline: 0 the story, 1 with macro entries and exits, 2 everything
     fail_on_hazard: bool = False
     hold: str = ""  # --interactive: inputs held at power-on, e.g. "2" or "2+3"
+    joystick: str = ""  # a rig: NAME=D@T1-T2,... (cli/run_rig.py)
 
 
 def run(req: Request) -> bool:
@@ -55,6 +56,15 @@ def run(req: Request) -> bool:
 
 
 def _run(req: Request) -> bool:
+    from mercmac.rig.load import is_rig_path
+
+    if is_rig_path(req.file):  # every controller of the rig on one clock (issue 18)
+        from mercmac.cli import run_rig
+
+        return run_rig.run(req)
+    if req.joystick:
+        raise UsageError("--joystick is for a rig file (*.rig.toml), whose [joystick] table "
+                         "says which controller each branch drives")
     presses = _presses(req.buttons)
     if req.scenario and presses:  # two button scripts for one run: which one wins is a guess
         raise UsageError("--scenario and --buttons cannot be used together: the scenario's "

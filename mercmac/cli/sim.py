@@ -18,6 +18,9 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
 @click.option("--buttons", default="", metavar="SPEC",
               help='Button script: "1@0-2s,2+3@5s-5.2s" (input B held from T1 to T2, or from T1 on). '
                    "Times without a unit are milliseconds. Overlapping presses of one button merge into one.")
+@click.option("--joystick", default="", metavar="SPEC",
+              help='A rig\'s joystick: "x=+0.5@1s-3s" holds the branch of controller x (or '
+                   "branch X, Y, Z) at deflection -1..1 from T1 to T2, then centred.")
 @click.option("--until", "until", default=None, metavar="DURATION",
               help="How long to simulate: 500ms, 10s, 2h, 1500d; a number without a unit is "
                    "milliseconds (--until 3 is 3 ms).  [default: 10s]")
@@ -54,9 +57,10 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
               help="Position of the reference switch that FE searches for.")
 @click.option("--hard-limits", default=None, metavar="NEG,POS",
               help="Positions of the limit switches, e.g. -200000,200000 (default: none).")
-def sim(file, buttons, until, fmt, verbose, trace, vcd, vcd_limit, plot, interactive, hold, speed, scenario,
+def sim(file, buttons, joystick, until, fmt, verbose, trace, vcd, vcd_limit, plot, interactive, hold, speed, scenario,
         fail_on_hazard, target, cycle, servo_off, reference_at, hard_limits) -> None:
-    """Simulate FILE on a virtual controller with a scripted pushbutton box.
+    """Simulate FILE on a virtual controller with a scripted pushbutton box; a rig file
+    (*.rig.toml) runs every controller on one clock (--buttons NAME:B@T1-T2).
 
     Macro 0 starts at power-on (t = 0). A file with errors is not simulated:
     its diagnostics are shown and the exit code is 1.
@@ -70,7 +74,7 @@ def sim(file, buttons, until, fmt, verbose, trace, vcd, vcd_limit, plot, interac
             interactive=interactive, speed=speed, scenario=scenario, target=target,
             cycle_ms=cycle, servo_off=servo_off, reference_at=reference_at,
             hard_limits=hard_limits, fail_on_hazard=fail_on_hazard, hold=hold,
-            verbose=verbose)
+            verbose=verbose, joystick=joystick)
         return EXIT_OK if run.run(request) else EXIT_FAILED
 
     run_guarded(work)

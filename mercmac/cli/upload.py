@@ -49,7 +49,7 @@ _TIMEOUT = click.option("--timeout", type=FiniteFloat(0.05, 60), default=1.0,
 
 def looks_like_program(text: str) -> bool:
     """A `.mcm` name, or an existing regular file: not a port (devices are not regular files)."""
-    if text.lower().endswith(".mcm"):
+    if text.lower().endswith((".mcm", ".rig.toml")):
         return True
     try:
         return Path(text).is_file()
@@ -109,21 +109,25 @@ def _timing(timeout: float):
 @_FIND_ADDRESS
 @_BAUD
 @click.option("--dry-run", is_flag=True, help="Read back and show the exact bytes; write nothing.")
-@click.option("--backup", type=click.Path(dir_okay=False, writable=True), callback=file_name,
+@click.option("--backup", type=click.Path(writable=True), callback=file_name,
               help="Where to save what the controller holds (default: a timestamped file "
-                   "in the per-user data directory).")
+                   "in the per-user data directory). For a rig: a folder (FOLDER/RIG-NAME.mcm "
+                   "each) or a prefix (PREFIX-NAME.mcm each).")
 @click.option("--erase-unused", is_flag=True, help="Remove stored macros the file does not define.")
 @click.option("--reset", is_flag=True, help="Send RT afterwards so that macro 0 starts.")
 @click.option("--force", is_flag=True, help="Flash even if the controller is not the file's target.")
 @click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
+@click.option("--only", callback=lambda ctx, param, v: only_names(v), metavar="NAME,..",
+              help="For a rig: flash only these controllers (names from the rig file).")
 @_TIMEOUT
 def flash(port, file, port_option, address, baud, dry_run, backup, erase_unused, reset, force,
-          target, timeout) -> None:
+          target, only, timeout) -> None:
     """Upload FILE to the controller on PORT: back up, write what differs, verify.
 
     PORT is anything pyserial opens: COM3, /dev/ttyUSB0, a pty path,
     socket://host:port. Without it: -p PORT, $MERCMAC_PORT, or the only likely
     Mercury port. Exit 0 only when every written macro reads back right.
+    FILE may be a rig (NAME.rig.toml): every controller at its address, in one run.
     """
     def work() -> int:
         nonlocal port, file
@@ -133,8 +137,12 @@ def flash(port, file, port_option, address, baud, dry_run, backup, erase_unused,
         from mercmac.upload import flasher
 
         given, file = split_flash_args(port, file, port_option)
+        rig = _rig_flash_options(file, only, force=force, target=target)
         port = _port(given, port_option, "flash")
         options = flasher.FlashOptions(erase_unused, dry_run, reset, Path(backup) if backup else None)
+        if rig:  # its --backup stays text: 'DIR/' names a folder (upload.rig.backup_paths)
+            options.backup = backup
+            return _flash_rig(port, file, only, baud, timeout, options, finished)
         try:
             result = flasher.flash_file(port, file, address=address, baud=baud,
                                         timing=_timing(timeout), options=options, target=target,
@@ -149,6 +157,97 @@ def flash(port, file, port_option, address, baud, dry_run, backup, erase_unused,
 
     finished = [None]  # the flash once it is complete: a Ctrl-C after that still says so
     run_guarded(lambda: _reporting_completion(work, finished))
+
+
+def only_names(value: str | None) -> list[str] | None:
+    """`--only x,y`: the names, each given once."""
+    if value is None:
+        return None
+    names = [n.strip() for n in value.split(",")]
+    if not all(names):
+        raise click.BadParameter(f"{value!r} has an empty name: give names such as x,y")
+    return list(dict.fromkeys(names))
+
+
+def _rig_flash_options(file: str, only, *, force: bool, target) -> bool:
+    """Whether FILE is a rig; UsageError for options that do not go with it (or without)."""
+    from mercmac.rig.load import is_rig_path
+
+    if not is_rig_path(file):
+        if only is not None:
+            raise UsageError("--only chooses controllers of a rig; FILE is no rig file",
+                             hint="mercmac flash [PORT] NAME.rig.toml --only x,y")
+        return False
+    given = click.get_current_context().get_parameter_source
+    default = click.core.ParameterSource.DEFAULT
+    for name, used in (("--address", given("address") is not default), ("--force", force),
+                       ("--target", target is not None)):
+        if used:
+            raise UsageError(f"{name} does not go with a rig: the rig file gives each "
+                             f"controller's address and model", hint=f"edit {file}")
+    return True
+
+
+def _flash_rig(port: str, file: str, only, baud: int, timeout: float, options, finished) -> int:
+    """`flash [PORT] RIG`: every controller of the rig, one table (mercmac.upload.rig)."""
+    from mercmac.render import upload as view
+    from mercmac.render.console import write_lines
+    from mercmac.upload import backup as backups
+    from mercmac.upload import rig
+
+    try:
+        result = rig.flash_rig(port, file, only=only, baud=baud, timing=_timing(timeout),
+                               options=options, watch=_rig_watch(port, finished))
+    except backups.BackupError as e:
+        raise _unwritable(e) from None
+    if options.dry_run:
+        write_lines(view.rig_dry_run_lines(result, baud))
+    write_lines(view.rig_summary(result, port))
+    return EXIT_OK
+
+
+def _rig_watch(port: str, finished: list):
+    """What `flash RIG` shows: diagnostics, who answered at each address, progress."""
+    from contextlib import contextmanager
+
+    from mercmac.render import report as render
+    from mercmac.render import upload as view
+    from mercmac.render.console import write_lines
+    from mercmac.upload import rig
+
+    class Shown(rig.RigWatch):
+        def refused_rig(self, findings) -> None:
+            from mercmac.diagnostics import Severity
+
+            errors = [d for f in findings for d in f.diagnostics if d.severity is Severity.ERROR]
+            sources = {f.compilation.source.name: f.compilation.source for f in findings}
+            render.write_text(errors, sources, len(findings), sys.stderr)
+
+        def refused(self, compilation) -> None:
+            render.write_errors(compilation)
+
+        def compiled(self, compilation) -> None:
+            render.write_warnings(compilation)
+
+        def identified(self, part, warning) -> None:
+            write_lines(view.identity_lines(port, part.member.address, part.identity, warning,
+                                            name=part.name))
+
+        @contextmanager
+        def meeting(self, part):
+            with view.FlashProgress() as progress:
+                yield progress
+
+        @contextmanager
+        def writing(self, part):
+            write_lines(view.rig_writing_lines(part))
+            with view.FlashProgress() as progress:
+                yield progress
+
+        def finished(self, result) -> None:
+            finished[0] = result
+
+    return Shown()
 
 
 def _reporting_completion(work, finished) -> int:
@@ -216,7 +315,10 @@ def _watch(port: str, address: int | None, finished: list):
 @_TIMEOUT
 @click.option("--raw", is_flag=True, help="The stored macros as [MCnn] lines, even when they "
                                           "match a flash in `mercmac history`.")
-def pull(port, port_option, output, address, baud, timeout, raw) -> None:
+@click.option("--rig", "rig_dir", type=click.Path(file_okay=False), callback=file_name,
+              help="Scan the chain and write a rig folder: DIR/NAME.rig.toml and a .mcm per "
+                   "controller that answers (names from `mercmac history` when known).")
+def pull(port, port_option, output, address, baud, timeout, raw, rig_dir) -> None:
     """Read every macro of the controller on PORT into a .mcm file.
 
     The file passes `mercmac check`, and `mercmac flash` puts back exactly
@@ -230,6 +332,12 @@ def pull(port, port_option, output, address, baud, timeout, raw) -> None:
         from mercmac.render.console import write_lines
         from mercmac.upload import backup, survey
 
+        if rig_dir is not None:
+            folder = rig_folder(rig_dir, output=output, address=address)
+            port = _port(port, port_option, "pull")
+            return pull_rig(port, folder, baud, timeout,
+                            lambda m: (m.pulled.text, "stored macros") if raw or not m.record
+                            else (m.record.source, "recorded source"))
         port = _port(port, port_option, "pull")
         to_file = output and output != "-"
         if to_file:
@@ -259,6 +367,55 @@ def pull(port, port_option, output, address, baud, timeout, raw) -> None:
         return EXIT_OK
 
     run_guarded(work)
+
+
+def rig_folder(rig_dir: str, *, output: str | None, address: int | None) -> Path:
+    """The folder `--rig DIR` writes to, refused before a controller is read (reading stops a
+    running macro) when it cannot be made or written; UsageError for options that do not go
+    with it."""
+    import os
+
+    for name, used in (("-o", output is not None), ("--address", address is not None)):
+        if used:
+            raise UsageError(f"{name} does not go with --rig: the rig folder gets a file per "
+                             f"controller that answers", hint="mercmac pull [PORT] --rig DIR")
+    folder = Path(rig_dir).absolute()
+    there = next(p for p in (folder, *folder.parents) if p.exists())
+    if not there.is_dir() or not os.access(there, os.W_OK | os.X_OK):
+        why = "not writable" if there.is_dir() else "no folder"
+        raise UsageError(f"--rig {rig_dir}: {there} is {why}",
+                         hint="give a folder that can be written (it is made if missing)")
+    return folder
+
+
+def pull_rig(port: str, folder: Path, baud: int, timeout: float, text_of) -> int:
+    """Scan PORT, read every controller, write FOLDER/NAME.rig.toml and NAME.mcm for each;
+    `text_of(member)`: a controller's .mcm text (stored macros, source, decompiled) and
+    what it is, for the table."""
+    import re
+
+    from mercmac import outfile
+    from mercmac.render import upload as view
+    from mercmac.render.console import write_lines
+    from mercmac.upload import rig
+
+    with view.AddressProgress(sys.stderr) as shown:
+        members = rig.pull_rig(port, baud=baud, timing=_timing(timeout),
+                               records=history_records(), on_address=shown)
+    name = rig.rig_name(members) or re.sub(r"\W+", "_", folder.name) or "rig"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise UsageError(f"--rig {folder}: cannot make the folder: {outfile.reason(e)}") from None
+    how = []
+    for m in members:
+        text, made = text_of(m)
+        outfile.write_text(folder / f"{m.name}.mcm", text)
+        how.append(made)
+    rig_file = folder / f"{name}.rig.toml"
+    outfile.write_text(rig_file, rig.rig_text(name, members, port))
+    write_lines(view.pulled_rig_lines(members, port, rig_file, how), sys.stderr)
+    return EXIT_OK
 
 
 def _searching():
@@ -353,12 +510,37 @@ def scan(port, port_option, baud, timeout, stop) -> None:
     run_guarded(work)
 
 
+def address_list(ctx, param, value: str | None) -> tuple[int, ...] | None:
+    """`--addresses 0,1,2`: distinct addresses 0-15 (DIP switches 1-4, MS176E §3.1.3)."""
+    if value is None:
+        return None
+    try:
+        addresses = tuple(int(part, 10) for part in value.split(","))
+    except ValueError:
+        raise click.BadParameter(f"{value!r} is not a comma-separated list of numbers "
+                                 "(e.g. 0,1,2)") from None
+    if bad := [a for a in addresses if not 0 <= a <= 15]:
+        raise click.BadParameter(f"address {bad[0]} is not 0-15 (MS176E §3.1.3)")
+    if len(set(addresses)) != len(addresses):
+        raise click.BadParameter(f"{value!r} names an address twice: each controller of a "
+                                 "chain has its own (MS176E §3.1)")
+    return addresses
+
+
 @click.command()
 @click.option("--target", type=MODEL_CHOICE, default="C-863", show_default=True,
-              help="Model the virtual controller reports.")
+              help="Model the virtual controller reports (every one, with --addresses).")
 @_ADDRESS
-@click.option("--state", type=click.Path(dir_okay=False),
-              help="Keep the macros (flash memory) in this file across runs.")
+@click.option("--addresses", callback=address_list, metavar="0,1,..",
+              help="Serve a daisy chain instead: a controller at each address, all on the one "
+                   "pty; only the selected one answers, every one runs its macros (MS176E §3.2).")
+@click.option("--rig", "rig_path", type=click.Path(dir_okay=False), metavar="RIG.rig.toml",
+              help="Serve the rig's chain: each controller at its address with its model, "
+                   "empty, and the rig's wires live between them (the box is not plugged in).")
+@click.option("--state", type=click.Path(),
+              help="Keep the macros (flash memory) across runs: in this file; for a chain "
+                   "(--addresses, --rig) in this folder, one ADDRESS.json (with --rig NAME.json) "
+                   "per controller.")
 @click.option("--firmware", default="2.30", show_default=True,
               help="Firmware version VE reports; 1.xx drops lines typed slower than 20 ms a character.")
 @click.option("--tm-framing", type=click.Choice([f.value for f in Framing]),
@@ -374,22 +556,24 @@ def scan(port, port_option, baud, timeout, stop) -> None:
                    "character gap, characters lost while a move runs.")
 @click.option("--baud", type=click.IntRange(300, 921_600), default=9600, show_default=True,
               help="Baud rate the link is paced at (with --pace).")
-def emulate(target, address, state, firmware, tm_framing, empty_slot, log_file, pace,
-            baud) -> None:
+def emulate(target, address, addresses, rig_path, state, firmware, tm_framing, empty_slot,
+            log_file, pace, baud) -> None:
     """Serve a virtual controller on a pseudo-terminal and print the path to open.
 
     Try `mercmac flash PATH FILE` without hardware; Ctrl-C stops it (exit 130).
+    With --addresses or --rig, a daisy chain on the one pty: Ctrl-A (0x01) and the address
+    as one hex digit select a controller (MS176E §3.1.1, §3.1.3).
     """
     def work() -> int:
         from contextlib import nullcontext
 
-        from mercmac.emulator.virtual import Faults, VirtualController
+        from mercmac.emulator.virtual import Faults
         from mercmac.emulator.ptyserver import PtyServer
         from mercmac.outfile import appending, reason
 
         faults = Faults(tm_framing=tm_framing, empty_slot=empty_slot, pace=pace, baud=baud)
-        vc = VirtualController(target.upper(), address, firmware=firmware,
-                               state=Path(state) if state else None, faults=faults)
+        vc = _virtual(target.upper(), address, addresses, rig_path, firmware=firmware,
+                      faults=faults, state=Path(state) if state else None)
         # a device, FIFO or folder is refused here, before the pseudo-terminal exists
         with appending(log_file) if log_file else nullcontext() as log:
             try:
@@ -399,8 +583,7 @@ def emulate(target, address, state, firmware, tm_framing, empty_slot, log_file, 
             kept = f", macros kept in {state}" if state else ""
             paced = f", paced at {baud} baud" if pace else ""
             logged = f", bytes logged to {log_file}" if log_file else ""
-            click.echo(f"virtual {vc.model} (firmware {firmware}) at address {address}"
-                       f"{kept}{paced}{logged}")
+            click.echo(f"{_served(vc, firmware)}{kept}{paced}{logged}")
             click.echo(server.path)
             try:
                 server.serve_forever()
@@ -412,3 +595,60 @@ def emulate(target, address, state, firmware, tm_framing, empty_slot, log_file, 
 
     run_guarded(work)
 
+
+def _virtual(model: str, address: int, addresses: tuple[int, ...] | None, rig_path: str | None,
+             **kw):
+    """What `emulate` serves: one controller, a chain at --addresses, or a --rig's chain."""
+    from mercmac.emulator import chain
+    from mercmac.emulator.virtual import VirtualController
+
+    given = click.get_current_context().get_parameter_source
+    chosen = [name for name, param in (("--addresses", "addresses"), ("--rig", "rig_path"),
+                                       ("--address", "address"))
+              if given(param) is not click.core.ParameterSource.DEFAULT]
+    if len(chosen) > 1:
+        raise UsageError(f"{' and '.join(chosen)} both given", hint="give one of them")
+    if rig_path is not None:
+        if given("target") is not click.core.ParameterSource.DEFAULT:
+            raise UsageError("--target and --rig both given: the rig file names each "
+                             "controller's model", hint="leave out --target")
+        return chain.for_rig(_emulated_rig(rig_path), **kw)
+    if addresses is not None:
+        return chain.at_addresses(addresses, model, **kw)
+    return VirtualController(model, address, **kw)
+
+
+# what a chain cannot be served without: the file itself, and an address 0-15 for each (§3.2);
+# the programs do not matter, as the emulated controllers start empty
+_CHAIN_RULES = ("rig-file", "rig-wire", "address-range", "address-repeated")
+
+
+def _emulated_rig(path: str):
+    """The rig at PATH; its file's errors are shown as `check` shows them (exit 2)."""
+    from mercmac.compiler.checking import choice_for
+    from mercmac.outfile import reason
+    from mercmac.render import report as render
+    from mercmac.rig.checks import check_rig
+    from mercmac.rig.load import read_rig
+
+    try:
+        rig_file = read_rig(path)
+    except OSError as e:
+        raise UsageError(f"--rig: cannot read {path}: {reason(e)}") from None
+    own = check_rig(rig_file, choice_for(path))[0]  # the rig file's findings come first
+    problems = [d for d in own.compilation.report.items if d.rule.name in _CHAIN_RULES]
+    if rig_file.rig is None or problems:
+        render.write_text(problems, {rig_file.source.name: rig_file.source}, 1, sys.stderr)
+        raise UsageError(f"--rig: {path} has errors; nothing is served",
+                         hint=f"mercmac check {path}")
+    return rig_file.rig
+
+
+def _served(vc, firmware: str) -> str:
+    """The first line `emulate` prints: what is served, at which addresses."""
+    from mercmac.emulator.chain import Chain
+
+    if not isinstance(vc, Chain):
+        return f"virtual {vc.model} (firmware {firmware}) at address {vc.address}"
+    return f"virtual chain (firmware {firmware}): " + ", ".join(
+        f"{c.model} at address {vc.label(c.address)}" for c in vc.controllers)

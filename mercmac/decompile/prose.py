@@ -15,10 +15,17 @@ from mercmac.decompile.lines import (Line, condition_run, every_period, model_of
 _UNITS = {C663: "steps"}  # MS176E §3: the C-663 counts microsteps, the C-863 encoder counts
 
 
-class _Reader:
+class Reader:
+    """A stored program read for describing: its lines, model, unit and macro names."""
+
     def __init__(self, macros: dict[int, str], model: str | None,
-                 given: dict[int, str] | None = None):
+                 given: dict[int, str] | None = None, inputs: dict[int, str] | None = None,
+                 outputs: dict[int, str] | None = None):
         self.lines = read_lines(macros)
+        # I/O lines that a rig wires to another controller, by number: 'input 2 (from
+        # y.out2)', 'output 1 (to y.in1)'; the others are the box's buttons and LEDs
+        # (MS176E §4.5.1).
+        self.inputs, self.outputs = inputs or {}, outputs or {}
         self.model = model_of(self.lines, model)
         self.unit = _UNITS.get(self.model, "counts") if self.model else "counts"
         # The source's names, as `sim` and `flash` show them (Macro.label); a raw slot's
@@ -27,6 +34,14 @@ class _Reader:
         self.names = names(self.lines, self.given)
 
     # -- words for one line -------------------------------------------------------------------------
+    def condition(self, run) -> str:
+        """The XN/XF of `run` in words: buttons held or not, wired inputs on or off."""
+        buttons = [o for o in run if o.arg not in self.inputs]
+        parts = [_condition(buttons)] if buttons else []
+        parts += [f"{self.inputs[o.arg]} is {'on' if o.mnemonic == Mnemonic.XN else 'off'}"
+                  for o in run if o.arg in self.inputs]
+        return " and ".join(parts)
+
     def label(self, slot: int) -> str:
         """'jog (MC01)' for a macro the source names, 'MC01 (mode_1)' for a raw one."""
         if slot in self.given and slot in self.lines:
@@ -45,7 +60,7 @@ class _Reader:
         run = condition_run(ops)
         if run:
             rest = ops[len(run):]
-            return (f"only while {_condition(run)}: "
+            return (f"only while {self.condition(run)}: "
                     + (self.phrase(rest, line) if rest else "nothing"))
         period = every_period(ops)
         if period is not None and not _repeats(ops[:-3]):
@@ -56,7 +71,7 @@ class _Reader:
         for i, op in enumerate(ops):
             run = condition_run(ops[i:])
             if run:
-                steps.append(f"only while {_condition(run)}: "
+                steps.append(f"only while {self.condition(run)}: "
                              + self.phrase(ops[i + len(run):], line))
                 mine = ops[:i]
                 break
@@ -82,7 +97,7 @@ class _Reader:
             if target is None:
                 return f"run {slot_name(n)} (not defined: nothing happens)"
             run = condition_run(target.ops)
-            when = f" if {_condition(run, at_start=True)}" if run and len(run) < len(target.ops) else ""
+            when = f" if {self.condition(run)}" if run and len(run) < len(target.ops) else ""
             return ("go to " if tail else "run ") + self.label(n) + when
         if m == Mnemonic.MR:
             return f"move {n:+,} {unit}"
@@ -102,12 +117,14 @@ class _Reader:
             return f"wait {n:,} ms"
         if m == Mnemonic.WS:
             return f"wait until on target and {1000 if n is None else n} ms more"
+        if m in (Mnemonic.WF, Mnemonic.WN) and n in self.inputs:
+            return f"wait until {self.inputs[n]} is {'off' if m == Mnemonic.WF else 'on'}"
         if m in (Mnemonic.WF, Mnemonic.WN):
             return f"wait until button {n} is {'released' if m == Mnemonic.WF else 'pressed'}"
         if m == Mnemonic.CP:
             return _leds(n)
         if m in (Mnemonic.CN, Mnemonic.CF):
-            return f"LED {n} {'on' if m == Mnemonic.CN else 'off'}"
+            return f"{self.outputs.get(n, f'LED {n}')} {'on' if m == Mnemonic.CN else 'off'}"
         if m == Mnemonic.RP:
             return f"repeat the line {plural(65535 if n is None else n, 'more time')}"
         if m == Mnemonic.FE:
@@ -146,7 +163,7 @@ class _Reader:
                 target = line.ops[-1].arg
                 if target in self.lines:
                     out.append({"mode": target, "name": self.names[target], "by": line.slot,
-                                "condition": _condition(run, at_start=True),
+                                "condition": self.condition(run),
                                 "first": self.phrase(list(line.ops[len(run):-1]), line) or "",
                                 "at_power_on": line.slot in self.startup()})
         return out
@@ -162,7 +179,7 @@ class _Reader:
                 t = self.lines.get(target)
                 run = condition_run(t.ops if t else None)
                 if t is not None and run:
-                    answers.append({"slot": target, "condition": _condition(run, at_start=True),
+                    answers.append({"slot": target, "condition": self.condition(run),
                                     "does": self.phrase(list(t.ops[len(run):]), t)})
             out.append({"slot": line.slot, "name": self.names[line.slot], "period_ms": period,
                         "answers": answers})
@@ -171,7 +188,7 @@ class _Reader:
     def leds(self) -> list[dict]:
         out = []
         for line in self.lines.values():
-            lit = [_leds(op.arg) if op.mnemonic == Mnemonic.CP else f"LED {op.arg} on"
+            lit = [_leds(op.arg) if op.mnemonic == Mnemonic.CP else self.command(op, tail=False)
                    for op in line.ops or () if op.mnemonic in (Mnemonic.CP, Mnemonic.CN)]
             if lit:
                 out.append({"slot": line.slot, "name": self.names[line.slot], "lights": lit})
@@ -240,31 +257,42 @@ def _series(steps: list[str]) -> str:
 # -- renderings ------------------------------------------------------------------------------------
 
 def describe(macros: dict[int, str], *, model: str | None = None, fmt: str = "text",
-             names: dict[int, str] | None = None) -> str:
-    """The program in words; `names`: the source's macro names by slot (Program.names())."""
-    reader = _Reader(macros, model, names)
+             names: dict[int, str] | None = None, level: int = 1,
+             inputs: dict[int, str] | None = None, outputs: dict[int, str] | None = None) -> str:
+    """The program in words; `names`: the source's macro names by slot (Program.names());
+    `level`: the markdown heading level of its title (a rig's programs are sections);
+    `inputs`, `outputs`: words for the lines a rig wires, by number (Reader.inputs)."""
+    reader = Reader(macros, model, names, inputs, outputs)
     data = reader.data()
     if fmt == "json":
         return json.dumps(data, indent=2, ensure_ascii=False) + "\n"
     if fmt not in ("text", "markdown"):
         raise ValueError(f"unknown format {fmt!r}: text, markdown or json")
     md = fmt == "markdown"
-    out = [f"# {_inline(_title(reader, data))}" if md else _title(reader, data)]
+    title, section = "#" * level, "#" * (level + 1)
+    out = [f"{title} {inline(_title(reader, data))}" if md else _title(reader, data)]
     for head, items in _sections(reader, data):
         if not items:
             continue
-        out += ["", f"## {head}" if md else f"{head}:"]
+        out += ["", f"{section} {head}" if md else f"{head}:"]
         out += [_item(depth, text, md) for depth, text in items]
     if md:
-        out += ["", "## Call graph", "", "```mermaid", _mermaid(reader), "```"]
+        out += ["", f"{section} Call graph", "", "```mermaid", _mermaid(reader), "```"]
     return "\n".join(out) + "\n"
+
+
+def described(macros: dict[int, str], *, model: str | None = None,
+              names: dict[int, str] | None = None, inputs: dict[int, str] | None = None,
+              outputs: dict[int, str] | None = None) -> dict:
+    """What `describe --format json` prints, as data (a rig's JSON holds one per program)."""
+    return Reader(macros, model, names, inputs, outputs).data()
 
 
 def _item(depth: int, text: str, md: bool) -> str:
     """One item of a section; a nested one under the item before it. In markdown a nested
     item starts at its parent's text (CommonMark §5.2: four spaces more make a code block)."""
     if md:
-        return "  " * depth + "- " + _inline(text)
+        return "  " * depth + "- " + inline(text)
     return "  " + "    " * depth + text
 
 
@@ -274,16 +302,17 @@ def _item(depth: int, text: str, md: bool) -> str:
 _MARKUP = re.compile(r"[\\`*\[\]<>&]|(?<!\w)_|_(?!\w)")
 
 
-def _inline(text: str) -> str:
+def inline(text: str) -> str:
+    """`text` as markdown shows it literally."""
     return _MARKUP.sub(lambda m: "\\" + m.group(), text)
 
 
-def _title(reader: _Reader, data: dict) -> str:
+def _title(reader: Reader, data: dict) -> str:
     model = f"a {reader.model}" if reader.model else "a Mercury controller (model unknown)"
     return f"{plural(len(reader.lines), 'macro')} for {model}; distances in {reader.unit}"
 
 
-def _sections(reader: _Reader, data: dict) -> list[tuple[str, list[tuple[int, str]]]]:
+def _sections(reader: Reader, data: dict) -> list[tuple[str, list[tuple[int, str]]]]:
     """The sections in order, each item (depth, text): depth 1 is an item of the one above."""
     label = reader.label
     power = [f"{label(0)}: {data['power_on']['does']}"] if data["power_on"] else [
@@ -313,7 +342,7 @@ def _top(texts: list[str]) -> list[tuple[int, str]]:
     return [(0, text) for text in texts]
 
 
-def _edges(reader: _Reader):
+def _edges(reader: Reader):
     """(caller, callee, label, tail) for every EM: `call` or `goto` (a tail EM, which never
     returns), with the condition that guards it: the XN/XF before it in the caller's line
     (a false one ends the line, MS176E §6.4 XN) and the one the callee starts with."""
@@ -328,10 +357,10 @@ def _edges(reader: _Reader):
             callee = reader.lines.get(op.arg)
             run = guards + condition_run(callee.ops if callee else ())
             words = "goto" if tail else "call"
-            yield s, op.arg, words + (f" if {_condition(run)}" if run else ""), tail
+            yield s, op.arg, words + (f" if {reader.condition(run)}" if run else ""), tail
 
 
-def _node(reader: _Reader, s: int) -> str:
+def _node(reader: Reader, s: int) -> str:
     """'MC15 mode_1' plus the loop it runs, if any: 'every 20 ms', 'repeat 10 times'."""
     period = every_period(reader.lines[s].ops)
     found = runs(reader.lines[s], reader.lines)
@@ -340,26 +369,39 @@ def _node(reader: _Reader, s: int) -> str:
     return f"{slot_name(s)} {reader.names[s]}" + (f" ({loop})" if loop else "")
 
 
-def _mermaid(reader: _Reader) -> str:
-    out = ["graph TD"]
+def _mermaid(reader: Reader) -> str:
+    return "\n".join(["graph TD", *mermaid_body(reader)])
+
+
+def mermaid_body(reader: Reader, prefix: str = "", indent: str = "    ") -> list[str]:
+    """The call graph's nodes and edges as mermaid lines, node ids `prefix` + 'MCnn'."""
+    out = []
     for s in reader.lines:
-        out.append(f'    {slot_name(s)}["{_node(reader, s)}"]')
+        out.append(f'{indent}{prefix}{slot_name(s)}["{_node(reader, s)}"]')
     for s, t, label, tail in _edges(reader):
-        out.append(f"    {slot_name(s)} {'-.->' if tail else '-->'}|{label}| {slot_name(t)}")
-    return "\n".join(out)
+        out.append(f"{indent}{prefix}{slot_name(s)} {'-.->' if tail else '-->'}|{label}| "
+                   f"{prefix}{slot_name(t)}")
+    return out
 
 
 def call_graph_dot(macros: dict[int, str], *, model: str | None = None,
                    names: dict[int, str] | None = None) -> str:
     """The call graph as Graphviz dot: solid edges for calls, dashed for a tail EM (goto),
     labelled with the condition that guards them; loops named on their macro."""
-    reader = _Reader(macros, model, names)
-    out = ["digraph macros {", "    rankdir=LR;", "    node [shape=box];",
-           "    edge [fontsize=10];"]
+    return "\n".join(["digraph macros {", "    rankdir=LR;", "    node [shape=box];",
+                      "    edge [fontsize=10];",
+                      *dot_body(Reader(macros, model, names)), "}"]) + "\n"
+
+
+def dot_body(reader: Reader, prefix: str = "", indent: str = "    ") -> list[str]:
+    """The call graph's nodes and edges as dot lines, node ids `prefix` + 'MCnn' (a rig
+    draws each controller's graph as a cluster of one picture)."""
+    out = []
     for s in reader.lines:
-        out.append(f'    {slot_name(s)} [label="{_node(reader, s).replace(" ", chr(92) + "n", 1)}"];')
+        out.append(f'{indent}{prefix}{slot_name(s)} '
+                   f'[label="{_node(reader, s).replace(" ", chr(92) + "n", 1)}"];')
     for s, t, label, tail in _edges(reader):
         style = ", style=dashed" if tail else ""
-        out.append(f'    {slot_name(s)} -> {slot_name(t)} [label="{label}"{style}];')
-    out.append("}")
-    return "\n".join(out) + "\n"
+        out.append(f'{indent}{prefix}{slot_name(s)} -> {prefix}{slot_name(t)} '
+                   f'[label="{label}"{style}];')
+    return out

@@ -3,7 +3,8 @@
 POSIX only (os.openpty). The server keeps its own handle on the terminal
 side open, so hosts may open and close the path as often as they like, and
 a `vanish` fault closes both ends to look like a pulled USB cable. With a
-log, every byte both ways goes to it as it passes, timestamped.
+log, every byte both ways goes to it as it passes, timestamped; on a chain of several
+controllers (chain.py) each line also says which controller was selected or answered.
 """
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ import time
 import tty
 from typing import IO
 
+from mercmac.emulator.chain import Chain
 from mercmac.emulator.virtual import VirtualController
 from mercmac.outfile import reason
 from mercmac.upload.protocol import show
@@ -24,12 +26,14 @@ log = logging.getLogger(__name__)
 
 
 class PtyServer:
-    """A VirtualController behind a pty; `path` is what to give `mercmac flash`."""
+    """A VirtualController (or a Chain of them) behind a pty; `path` is what to give
+    `mercmac flash`."""
 
-    def __init__(self, controller: VirtualController, log: IO[str] | None = None):
+    def __init__(self, controller: VirtualController | Chain, log: IO[str] | None = None):
         if not hasattr(os, "openpty"):
             raise OSError("pseudo-terminals need a POSIX system (Linux, macOS)")
-        self.controller = controller
+        self.controller = controller  # what `call` hands over
+        self.chain = controller if isinstance(controller, Chain) else Chain([controller])
         self._master, self._slave = os.openpty()
         tty.setraw(self._slave)  # no echo, no CR->LF translation: bytes pass unchanged
         os.set_blocking(self._master, False)  # a host that stops reading must not stall us
@@ -40,7 +44,7 @@ class PtyServer:
         self._t0 = time.monotonic()
         self._failures: set[str] = set()  # logged once each, however often they recur
         self._log = log  # `mercmac emulate --log`: the caller opens and closes it
-        self._note(f"# {time.strftime('%Y-%m-%d %H:%M:%S %z')} virtual {controller.model} on "
+        self._note(f"# {time.strftime('%Y-%m-%d %H:%M:%S %z')} {self._what()} on "
                    f"{self.path}; seconds since then, -> host to controller, <- back")
 
     def __enter__(self) -> "PtyServer":
@@ -61,10 +65,10 @@ class PtyServer:
             ready, _, _ = select.select([self._master], [], [], TICK_S)
             now = time.monotonic() - self._t0
             data = self._read() if ready else b""
-            if data:
-                self._record(now, "->", data)
             with self._lock:
                 out, vanished = self._serve(data, now)
+            if data:
+                self._record(now, "->", data, self._selection())
             if out:
                 self._send(out, time.monotonic() - self._t0)
             if vanished:
@@ -75,9 +79,9 @@ class PtyServer:
         """One turn of the controller; a bug in it is logged, and serving goes on."""
         try:
             if data:
-                self.controller.receive(data, now)
-            self.controller.tick(now)
-            return self.controller.take(), self.controller.vanished
+                self.chain.receive(data, now)
+            self.chain.tick(now)
+            return self.chain.take(), self.chain.vanished
         except Exception as e:  # noqa: BLE001 - an emulator that dies loses every macro
             message = f"emulator: {type(e).__name__}: {e}; still serving"
             if message not in self._failures:
@@ -96,9 +100,31 @@ class PtyServer:
             self._thread.join(timeout=2)
         self._close_fds()
 
-    def _record(self, now: float, way: str, data: bytes) -> None:
-        """One line of the log: time, direction, the bytes in hex and as text (<CR>, <ETX>)."""
-        self._note(f"{now:12.6f} {way} {data.hex(' ')}  {show(data)}")
+    def _what(self) -> str:
+        """The header's words for what is served: a controller, or a chain by address."""
+        cs = self.chain.controllers
+        if len(cs) == 1:
+            return f"virtual {cs[0].model}"
+        return "virtual chain of " + ", ".join(
+            f"{c.model} at {self.chain.label(c.address)}" for c in cs)
+
+    def _selection(self) -> str:
+        """After bytes from the host, which controller of a chain takes the next ones."""
+        if len(self.chain.controllers) == 1:
+            return ""
+        chosen = [self.chain.label(c.address) for c in self.chain.selected()]
+        return f"  [selected: {', '.join(chosen) or 'none'}]"
+
+    def _speakers(self, data: bytes) -> list[tuple[bytes, str]]:
+        """The reply, and on a chain each controller's part of it with its name."""
+        if len(self.chain.controllers) == 1:
+            return [(data, "")]
+        return [(part, f"  [from {self.chain.label(a)}]") for a, part in self.chain.parts]
+
+    def _record(self, now: float, way: str, data: bytes, who: str = "") -> None:
+        """One line of the log: time, direction, the bytes in hex and as text (<CR>, <ETX>),
+        and on a chain which controller was selected or answered."""
+        self._note(f"{now:12.6f} {way} {data.hex(' ')}  {show(data)}{who}")
 
     def _note(self, line: str) -> None:
         if self._log is None:
@@ -117,7 +143,11 @@ class PtyServer:
 
     def _send(self, data: bytes, now: float) -> None:
         # logged first: a host (or Ctrl-C) that acts on the reply at once finds it in the log
-        self._record(now, "<-", data)
+        for part, who in self._speakers(data):
+            self._record(now, "<-", part, who)
+        if len(self.chain.parts) > 1:  # §3.2: only the selected one talks; a real bus garbles
+            self._note(f"{now:12.6f} <- several controllers answered at once: a collision "
+                       "on a real chain (SC in macro 0 of networked controllers, §3.1.2?)")
         sent = self._write(data)
         if sent < len(data):
             self._note(f"{now:12.6f} <- the last {len(data) - sent} of these bytes were lost: "

@@ -193,8 +193,13 @@ class VirtualController:
             self._out += text.encode("latin-1") + REPORT_END
 
     def _run(self, now: float) -> None:
-        """Advance the VM to wall time `now`; a failure stops the macro, not the controller."""
-        self._safely("a running macro", self.machine.run_until, now * 1000)
+        """Advance the VM to wall time `now` (seconds)."""
+        self.advance(now * 1000)
+
+    def advance(self, t_ms: float) -> None:
+        """Run the VM to `t_ms` (a chain steps its wired machines together); a failure
+        stops the macro, not the controller."""
+        self._safely("a running macro", self.machine.run_until, t_ms)
 
     def _run_due(self, now: float) -> None:
         """Also run what is due at `now` itself: the first command of a line just typed,

@@ -7,7 +7,8 @@ editor's workspace settings (mercmac.lsp.settings); only the compiling is increm
 (mercmac.lsp.recheck). The other features read that check's AST and lowered program
 (mercmac.lsp.symbols, mercmac.lsp.completion). Documents keep the editor's lines and
 convert every position, read or sent (mercmac.lsp.document); messages are read so that
-a bad frame does not stop the server (mercmac.lsp.framing).
+a bad frame does not stop the server (mercmac.lsp.framing). Rig files get what `check
+RIG` reports on them, and a rig's programs its models (mercmac.lsp.rigs).
 """
 from __future__ import annotations
 
@@ -27,9 +28,9 @@ from pygls.lsp.server import LanguageServer
 from mercmac import __version__, config
 from mercmac.commands import MODELS, Mnemonic
 from mercmac.compiler import Compilation, checking
-from mercmac.diagnostics import Diagnostic, Fix, Severity
+from mercmac.diagnostics import Diagnostic, Fix, Report, Severity
 from mercmac.errors import MercmacError, SettingsError
-from mercmac.lsp import completion as completion_rules, framing, settings, symbols
+from mercmac.lsp import completion as completion_rules, framing, rigs, settings, symbols
 from mercmac.lsp.document import Document, Documents
 from mercmac.lsp.recheck import Checked, Rechecker
 from mercmac.mdtext import slot_name
@@ -58,12 +59,13 @@ class Refusal(JsonRpcException):
 
 class Seen:
     """The latest check of one open document: the re-checker's result and what `check`
-    reports of it; the items of a file with syntax errors are read when first wanted."""
+    reports of it; the items of a file with syntax errors are read when first wanted.
+    A rig file (`rig`) has diagnostics only: it is TOML, with no macros to navigate."""
 
-    __slots__ = ("checked", "diagnostics", "_items")
+    __slots__ = ("checked", "diagnostics", "_items", "rig")
 
-    def __init__(self, checked: Checked, diagnostics: list[Diagnostic]):
-        self.checked, self.diagnostics, self._items = checked, diagnostics, None
+    def __init__(self, checked: Checked, diagnostics: list[Diagnostic], rig: bool = False):
+        self.checked, self.diagnostics, self._items, self.rig = checked, diagnostics, None, rig
 
     @property
     def compilation(self) -> Compilation:
@@ -74,7 +76,7 @@ class Seen:
         """The AST's items; with syntax errors, those of every block as far as it parses
         (the re-checker keeps only the blocks without errors), so that a block being
         typed stays in the outline."""
-        if self.checked.module is not None:
+        if self.checked.module is not None or self.rig:
             return self.checked.items
         if self._items is None:
             self._items = symbols.partial_items(self.compilation.source.text)
@@ -131,6 +133,9 @@ class MercmacServer(LanguageServer):
         if not self.stale:
             asyncio.get_running_loop().call_soon(self.check_stale)
         self.stale.add(uri)
+        if rigs.is_rig_path(uri):  # its programs are checked with the models it names
+            self.stale.update(u for u in self.workspace.text_documents
+                              if not rigs.is_rig_path(u))
 
     def check_stale(self) -> None:
         """Check what changed; what a failure left unchecked is checked next. While the
@@ -149,9 +154,18 @@ class MercmacServer(LanguageServer):
         """Check `uri` as `check` would, and publish what it reports."""
         self.stale.discard(uri)
         document: Document = self.workspace.get_text_document(uri)
+        if rigs.is_rig_path(uri):
+            return self.recheck_rig(uri, document)
         self.parsed.pop(uri, None)
-        found = checking.check(Source(_name(uri), document.source), self.choice(uri),
-                               lambda source, target: self._compile(uri, source, target))
+        choice, owner = self.choice(uri), self.owner(uri)
+        if owner is not None:  # the rig says which controller, hence which model
+            choice = choice._replace(target=owner.controller.model)
+        source = Source(_name(uri), document.source)
+        found = checking.check(source, choice,
+                               lambda source, target: self._compile(uri, source, target, owner))
+        if owner is not None:
+            found = found._replace(diagnostics=found.diagnostics + self.rig_rules(owner, source,
+                                                                                 choice))
         checked = self.parsed.pop(uri, None)
         if checked is None:  # a compiler bug, reported on the file: start afresh next time
             self.checkers.pop(uri, None)
@@ -164,13 +178,54 @@ class MercmacServer(LanguageServer):
             diagnostics=_diagnostics(found.diagnostics, document)))
         return seen
 
-    def _compile(self, uri: str, source: Source, target: str | None) -> Compilation:
-        """The re-checker's compilation; its AST is kept for the other features."""
+    def _compile(self, uri: str, source: Source, target: str | None,
+                 owner: rigs.Owner | None = None) -> Compilation:
+        """The re-checker's compilation; its AST is kept for the other features. A program
+        of a rig also gets the rig's model-mismatch on a `target` line of another model."""
         checker = self.checkers.get(uri)
         if checker is None or checker.target != target:
             checker = self.checkers[uri] = Rechecker(source.name, target)
         checked = self.parsed[uri] = checker.check(source.text)
-        return checked.compilation
+        if owner is None:
+            return checked.compilation
+        return rigs.with_rig_model(checked.compilation, owner, checked.items)
+
+    def recheck_rig(self, uri: str, document: Document) -> Seen:
+        """Check a rig file as `check RIG` would, and publish what it reports on the file."""
+        source = Source(_path(uri), document.source)  # its programs are relative to it
+        try:
+            found = rigs.rig_diagnostics(source, self.choice(uri))
+        except Exception as e:  # a bug in the rig checks: said, and the server serves on
+            self.say(f"checking {_name(uri)}: {type(e).__name__}: {e}"[:300])
+            found = []
+        seen = self.checks[uri] = Seen(Checked(Compilation(source, Report(source.name), None),
+                                               None, ()), found, rig=True)
+        self.text_document_publish_diagnostics(t.PublishDiagnosticsParams(
+            uri=uri, version=document.version, diagnostics=_diagnostics(found, document)))
+        return seen
+
+    def rig_rules(self, owner: rigs.Owner, source: Source, choice) -> list[Diagnostic]:
+        """The rig rules `check RIG` reports in a program of the rig (rigs)."""
+        try:
+            return rigs.program_rig_diagnostics(owner, source, choice)
+        except Exception as e:  # a bug in the rig checks must not stop the file's own check
+            self.say(f"checking the rig of {source.name}: {type(e).__name__}: {e}"[:300])
+            return []
+
+    def owner(self, uri: str) -> rigs.Owner | None:
+        """The rig that names the document at `uri` as a program (its open text counts)."""
+        if not uri.startswith("file:"):
+            return None
+
+        def open_text(path: str) -> str | None:
+            document = self.workspace.text_documents.get(uris.from_fs_path(path))
+            return None if document is None else document.source
+
+        try:
+            return rigs.owner_of(uris.to_fs_path(uri), open_text)
+        except Exception as e:  # a bug in reading rigs must not stop the file's own check
+            self.say(f"finding the rig of {_name(uri)}: {type(e).__name__}: {e}"[:300])
+            return None
 
     def checked(self, uri: str) -> Seen:
         """The check of the document as it is now."""
@@ -234,6 +289,11 @@ class MercmacServer(LanguageServer):
 
 def _name(uri: str) -> str:
     return uri.rsplit("/", 1)[-1] or uri
+
+
+def _path(uri: str) -> str:
+    """The file's path for a `file:` URI, else its name."""
+    return (uris.to_fs_path(uri) or _name(uri)) if uri.startswith("file:") else _name(uri)
 
 
 def _diagnostics(found: list[Diagnostic], document: Document) -> list[t.Diagnostic]:
@@ -319,6 +379,8 @@ def did_save(ls: MercmacServer, params: t.DidSaveTextDocumentParams) -> None:
     else:
         config.forget()
         ls.changed(params.text_document.uri)
+        # a rig's checks read its programs as saved
+        ls.stale.update(u for u in ls.workspace.text_documents if rigs.is_rig_path(u))
 
 
 @server.feature(t.TEXT_DOCUMENT_DID_CLOSE)
@@ -339,6 +401,8 @@ def _at(ls: MercmacServer, params) -> tuple[Document, Seen, int, int]:
 
 
 def _uses(seen: Seen) -> list[symbols.Use]:
+    if seen.rig:  # a rig file names no macros or consts
+        return []
     return symbols.uses(seen.items, seen.compilation.source, seen.compilation.program)
 
 
@@ -348,7 +412,7 @@ def hover(ls: MercmacServer, params: t.HoverParams) -> t.Hover | None:
     period; the explanation of each reported diagnostic under it."""
     document, seen, line, column = _at(ls, params)
     parts, spans = [], []
-    for text, span in _meanings(seen, line, column):
+    for text, span in () if seen.rig else _meanings(seen, line, column):
         parts.append(text)
         spans.append(span)
     for d in seen.diagnostics:
@@ -393,6 +457,8 @@ def _meanings(seen: Seen, line: int, column: int):
 def completion(ls: MercmacServer, params: t.CompletionParams) -> t.CompletionList:
     """The words that may stand at the cursor (mercmac.lsp.completion)."""
     uri = params.text_document.uri
+    if rigs.is_rig_path(uri):  # TOML: no macro words to offer
+        return t.CompletionList(is_incomplete=False, items=[])
     document: Document = ls.workspace.get_text_document(uri)
     offset = document.offset_at(params.position)
     text = document.source
@@ -532,6 +598,8 @@ def document_symbols(ls: MercmacServer, params: t.DocumentSymbolParams) -> list[
 @server.feature(t.TEXT_DOCUMENT_FORMATTING)
 def formatting(ls: MercmacServer, params: t.DocumentFormattingParams) -> list[t.TextEdit] | None:
     """The whole document as `mercmac fmt` writes it (one edit), or no edit."""
+    if rigs.is_rig_path(params.text_document.uri):  # `fmt RIG` leaves the TOML as written
+        return None
     format_text = formatter()
     document: Document = ls.workspace.get_text_document(params.text_document.uri)
     text = document.source
@@ -565,7 +633,7 @@ def code_actions(ls: MercmacServer, params: t.CodeActionParams) -> list[t.CodeAc
                              diagnostics=[_diagnostic(d, document)], is_preferred=True,
                              edit=_edit(uri, document, d.fix))
                 for d in seen.diagnostics if d.fix is not None and _touches(d.span, *wanted)]
-    if _wanted(params.context.only, ADD_TARGET):
+    if _wanted(params.context.only, ADD_TARGET) and not seen.rig:
         out += _add_target(uri, seen, document)
     return out
 

@@ -12,25 +12,57 @@ COLUMNS = ("time", "port", "address", "model", "firmware", "file", "macros")
 
 
 def table_lines(records) -> list[Line]:
-    """One row per flash, newest first as given; a note when there are none."""
+    """One row per flash, newest first as given; the controllers of one rig flash under a
+    line that names the rig (issue 18); a note when there are none."""
     if not records:
         return [[("no flashes recorded yet: `mercmac flash` records each verified upload", "")]]
-    rows = [COLUMNS] + [_row(r) for r in records]
+    groups = rig_groups(records)
+    rows = [COLUMNS] + [_row(r) for group in groups for r in group]
     widths = [max(len(row[i]) for row in rows) for i in range(len(COLUMNS))]
-    out = []
-    for n, row in enumerate(rows):
-        text = "  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip()
-        out.append([(text, "bold" if n == 0 else "")])
+    out, rows_left = [_cells(rows[0], widths, "bold")], iter(rows[1:])
+    for group in groups:
+        if group[0].rig is not None:
+            out.append([(_rig_heading(group), "bold")])
+        out += [_cells(next(rows_left), widths, "") for _ in group]
     return out
 
 
+def rig_groups(records) -> list[list]:
+    """The records in runs: the controllers of one rig flash together (the same rig file
+    and port, each controller once), every other record alone."""
+    groups: list[list] = []
+    for r in records:
+        last = groups[-1] if groups else None
+        if (r.rig is not None and last and last[0].rig == r.rig and last[0].port == r.port
+                and r.controller not in {x.controller for x in last}):
+            last.append(r)
+        else:
+            groups.append([r])
+    return groups
+
+
+def _rig_heading(group) -> str:
+    """'rig raster (/home/me/raster.rig.toml): 2 controllers'"""
+    first = group[0]
+    count = f"{len(group)} controller{'s' * (len(group) != 1)}"
+    return f"rig {printable(first.rig_name or '?')} ({printable(first.rig)}): {count}"
+
+
+def _cells(row: tuple[str, ...], widths: list[int], style: str) -> Line:
+    return [("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip(), style)]
+
+
 def to_json(records) -> str:
-    """{"flashes": [{time, port, address, model, firmware, file, macros: {slot: line}, backup}]}"""
+    """{"flashes": [{time, port, address, model, firmware, file, macros: {slot: line}, backup,
+    rig}]}; `rig` is {file, name, controller} for a controller flashed as part of a rig."""
     return json.dumps({"flashes": [{
         "time": r.time, "port": r.port, "address": r.address, "model": r.model,
         "firmware": r.firmware, "file": r.file,
         "macros": {str(slot): line for slot, line in sorted(r.macros.items())},
-        "backup": r.backup} for r in records]}, indent=2)
+        "backup": r.backup,
+        "rig": None if r.rig is None else {"file": r.rig, "name": r.rig_name,
+                                           "controller": r.controller}} for r in records]},
+        indent=2)
 
 
 def skipped_lines(skipped) -> list[Line]:
@@ -41,8 +73,11 @@ def skipped_lines(skipped) -> list[Line]:
 
 
 def label(record) -> str:
-    """'four-modes.mcm, flashed 2026-11-22 10:41 from /home/me/four-modes.mcm'."""
-    return (f"{printable(record.name)}, flashed {record.when.strftime('%Y-%m-%d %H:%M')} "
+    """'four-modes.mcm, flashed 2026-11-22 10:41 from /home/me/four-modes.mcm'; a rig's
+    'x.mcm (x of rig raster), flashed ...'."""
+    rig = "" if record.rig is None else \
+        f" ({printable(record.controller or '?')} of rig {printable(record.rig_name or '?')})"
+    return (f"{printable(record.name)}{rig}, flashed {record.when.strftime('%Y-%m-%d %H:%M')} "
             f"from {printable(record.file)}")
 
 
@@ -53,6 +88,9 @@ def stale_text(recalled, instead: str) -> str:
 
 
 def _row(r) -> tuple[str, ...]:
-    return (r.when.strftime("%Y-%m-%d %H:%M:%S"), printable(r.port), str(r.address),
-            printable(r.model or "?"), printable(r.firmware), printable(r.file),
-            str(len(r.macros)))
+    """A record's cells; a rig's controller indented under its rig, its name before its file."""
+    file = printable(r.file) if r.controller is None else \
+        f"{printable(r.controller)}: {printable(r.file)}"
+    indent = "  " if r.rig is not None else ""
+    return (indent + r.when.strftime("%Y-%m-%d %H:%M:%S"), printable(r.port), str(r.address),
+            printable(r.model or "?"), printable(r.firmware), file, str(len(r.macros)))

@@ -204,6 +204,12 @@ def _story(events: list, level: int) -> Iterator[tuple[int, Line]]:
     yield from _stretch(folds, level)
 
 
+def dated_lines(events: list, level: int = 0) -> Iterator[tuple[int, Line]]:
+    """The timeline's shown lines of `events` (a recorder's timeline) with their times in
+    us, for a caller that merges several timelines into one (a rig, render/rig.py)."""
+    return _story(events, level)
+
+
 def timeline(rec: Recorder, level: int = 0) -> list[Line]:
     """The timeline at a verbosity: 0 the story, 1 with macro entries and exits, 2 all.
 
@@ -302,6 +308,11 @@ def write_scenario_passed(path: str, checked: int, stream: IO[str] | None = None
 
 def to_json(run: Run) -> str:
     """SPEC §5 `sim --format json`."""
+    return json.dumps(run_json(run), indent=2)
+
+
+def run_json(run: Run) -> dict:
+    """The object of SPEC §5 `sim --format json` (a rig's has one per controller)."""
     rec = run.record
     out = {
         "until_ms": run.until_ms,
@@ -321,7 +332,7 @@ def to_json(run: Run) -> str:
     truncated = _truncated(rec)
     if truncated:
         out["truncated"] = truncated
-    return json.dumps(out, indent=2)
+    return out
 
 
 JSON_CAP = record.CAP  # SPEC §5: each JSON list keeps its first 10,000 entries

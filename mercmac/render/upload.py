@@ -26,11 +26,12 @@ _WOULD_TALLY = {"written": "write {n}", "erased": "erase {n}", "re-written last"
 
 
 def identity_lines(port: str, address: int, identity, warning: str | None = None, *,
-                   searched: bool = False) -> list[Line]:
+                   searched: bool = False, name: str = "controller") -> list[Line]:
     """'C-863, firmware 2.30, at address 0 on /dev/ttyUSB0' and what we had to do;
-    `searched`: no --address was given and the address was found by a search."""
+    `searched`: no --address was given and the address was found by a search; `name`: the
+    controller's name in a rig."""
     v = identity.version
-    lines: list[Line] = [[("controller: ", "bold"), (f"{v.name}, firmware {v.firmware}", "cyan"),
+    lines: list[Line] = [[(f"{name}: ", "bold"), (f"{v.name}, firmware {v.firmware}", "cyan"),
                           (f", at address {address} on {port}", "")]]
     if searched:
         lines.append([("note: ", "bold"), (f"no --address given and nothing at 0: address {address} "
@@ -203,6 +204,9 @@ def _kept(n: int, dry_run: bool) -> str:
 
 def completed_text(result) -> str:
     """The outcome of a finished flash in plain words, for a Ctrl-C while it is being shown."""
+    if hasattr(result, "parts"):  # a rig (mercmac.upload.rig.RigResult)
+        return "the rig flash had finished:\n" + "\n".join(
+            f"  {p.name} (address {p.member.address}): {p.state.value}" for p in result.parts)
     if result.dry_run:
         return f"dry run complete, nothing was written; {_would(result.plan)}"
     reset = "; RT was sent, macro 0 is starting" if result.reset else ""
@@ -235,11 +239,15 @@ def _would(plan) -> str:
 
 def dry_run_lines(result, address: int | None, baud: int) -> list[Line]:
     """Every byte a real flash would now send, and what for."""
-    from mercmac.upload.protocol import show
-
     if result.plan.changes_nothing:
         return [[("nothing to send: ", "bold"), ("the controller already holds this program", "")]]
-    wire = result.wire(address)
+    return wire_lines(result.wire(address), baud)
+
+
+def wire_lines(wire: list[tuple[bytes, str]], baud: int) -> list[Line]:
+    """The bytes of a dry run, one command a line with what it is for, and their time."""
+    from mercmac.upload.protocol import show
+
     lines: list[Line] = [[("bytes a flash would send after the read-back:", "bold")]]
     for data, purpose in wire:
         lines.append([("  -> ", "dim"), (f"{show(data):<64}", "cyan"), (f" {purpose}", "dim")])
@@ -282,3 +290,75 @@ def _name(name: str | None, slot: int) -> str:
     if not name or name == tag:
         return "-"
     return name.replace(f" ({tag})", "")
+
+
+# -- rigs (mercmac.upload.rig) ---------------------------------------------------------------
+
+def rig_dry_run_lines(result, baud: int) -> list[Line]:
+    """Every byte a rig flash would now send, selection codes included, and what for."""
+    if result.changes_nothing:
+        return [[("nothing to send: ", "bold"), ("every controller already holds its program", "")]]
+    return wire_lines(result.wire(), baud)
+
+
+def rig_summary(result, port: str) -> list[Line]:
+    """A row per controller of the rig, and the outcome line."""
+    import os
+
+    rows = [(p.name, str(p.member.address), p.member.model, os.path.basename(p.member.program),
+             _rig_cell(p, result.dry_run), str(p.result.backup) if p.result and p.result.backup
+             else "-") for p in result.parts]
+    lines = table(("controller", "address", "model", "program", "a flash" if result.dry_run
+                   else "result", "backup"), rows, style_of=_rig_style)
+    chosen = [p for p in result.parts if p.result]
+    which = (f"every controller of {result.rig.name}" if len(chosen) == len(result.parts)
+             else f"each of the {plural(len(chosen), 'chosen controller')}")
+    if result.dry_run:
+        lines.append([("dry run: ", "bold yellow"), (f"nothing written to "
+                                                     f"{plural(len(chosen), 'controller')} of "
+                                                     f"{result.rig.name}", "")])
+    elif result.changes_nothing:
+        lines.append([("ok: ", "bold green"), (f"nothing to write: {which} already holds its "
+                                               f"program", "")])
+    else:
+        lines.append([("ok: ", "bold green"), (f"{result.rig.name} on {port}: "
+                                               f"{plural(len(chosen), 'controller')} verified", "")])
+    lines += [[("warning: ", "bold yellow"), (f"{p.name}: the flash could not be recorded in the "
+                                              f"history ({p.result.unrecorded})", "")]
+              for p in chosen if p.result.unrecorded]
+    if result.reset:
+        lines.append([("reset: ", "bold"), ("RT sent to each, macro 0 is starting", "")])
+    return lines
+
+
+def rig_writing_lines(part) -> list[Line]:
+    """'y (address 1): writing 2 macros', or that it holds its program already."""
+    plan = part.result.plan
+    what = ("nothing to write: it holds its program" if plan.changes_nothing
+            else f"{plural(len(plan.steps), 'step')}, macro 0 last")
+    return [[(f"{part.name} (address {part.member.address}): ", "bold"), (what, "")]]
+
+
+def _rig_cell(part, dry_run: bool) -> str:
+    """'written 3, unchanged 1' (or what a flash would do), else the controller's state."""
+    if part.result is None:
+        return part.state.value
+    if dry_run:
+        return _would(part.result.plan).removeprefix("a flash would ")
+    if part.result.plan.changes_nothing:
+        return "unchanged"
+    return f"{part.state.value}: {_tally(part.result.plan)}"
+
+
+def _rig_style(row) -> str:
+    return "bold green" if row[4].startswith("flashed") else "dim" if row[4] == "unchanged" else ""
+
+
+def pulled_rig_lines(members, port: str, rig_file, how: list[str]) -> list[Line]:
+    """A row per controller read from the chain, what its file holds (`how`), the rig file."""
+    rows = [(m.name, str(m.address), m.pulled.identity.version.name,
+             plural(len(m.pulled.macros), "macro"), made) for m, made in zip(members, how)]
+    lines = table(("controller", "address", "model", "holds", "written as"), rows)
+    lines.append([("rig: ", "bold"), (f"{rig_file} ({plural(len(members), 'controller')} on "
+                                      f"{port}; wires cannot be read: add them)", "")])
+    return lines

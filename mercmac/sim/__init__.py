@@ -6,6 +6,7 @@
     vcd.py         Value Change Dump output
     plot.py        the --plot picture (matplotlib, imported only when drawing)
     plot_html.py   the page around the picture for `--plot FILE.html`: zoom and pan
+    rig_plot.py    a rig's --plot: a lane per axis, the wires, the path (X against Y)
 
 Rendering lives in `mercmac.render.sim`, which reads these (never the other way); the
 `sim` command's work, options to timeline, and the keyboard as a C-170.PB pushbutton box

@@ -8,7 +8,9 @@ readable. The position axis spans where the stage goes; a target far outside
 it (a jog's 9999999, stopped after a moment) is an arrow on the edge with its
 value. A label is drawn only where it fits. PNG, SVG and PDF come from
 matplotlib (the extra `plot`, imported only here and only when drawing); HTML is
-the SVG in a page that zooms and pans (plot_html.py).
+the SVG in a page that zooms and pans (plot_html.py). A rig's plot (rig_plot.py) is
+made of the same lanes: `position`, `bars`, `macros`, `time_lanes` and `save`.
+Skipped passes that move are drawn as copies of the pass before them.
 """
 from __future__ import annotations
 
@@ -17,7 +19,7 @@ import math
 import os
 import re
 from bisect import bisect_left, bisect_right
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from mercmac.errors import InputError
 from mercmac.outfile import replacing, writable_target
@@ -30,6 +32,8 @@ MISSING = "needs the plot extra: pip install 'mercmac[plot]'"
 COMPRESS_US = 10_000_000  # skipped stretches longer than this (10 s) are drawn compressed
 BAND = 0.06  # a compressed stretch's width, as a share of the time drawn to scale
 CURVE = 16  # points per accelerating profile segment
+COPIED = 20_000  # position samples of skipped passes drawn as copies of the pass before
+SKIP_OUTPUTS = 1000  # output changes of one skip drawn one by one; more: its last pattern
 CAP = 200_000  # recorded changes; past this the plot stops (a marked cut) and the run goes on
 LANES = ("position", "buttons", "LEDs", "macro")
 # A lane of more bars than this is drawn at 1/3000 of the time axis, a quarter of a point
@@ -142,9 +146,49 @@ class PlotObserver:
                 self.trace.hazards.append((t, rule))
             case ev.FastForwarded(_, t_to, passes, _, loop, shape):
                 self.trace.skips.append((t, t_to, passes, loop.label))
-                last = _last_pattern(shape)
-                if last is not None:
-                    self._pattern(last, t_to)
+                self._skipped_outputs(event)
+                if not ff.plain(shape) or event.shift:
+                    self._moved(event)
+
+    def _skipped_outputs(self, skip: ev.FastForwarded) -> None:
+        """The output changes of skipped passes, each where a few (a rig's wire lanes show
+        every handshake); of many, the pattern the last pass leaves (a hatched band)."""
+        if ff.count(skip.shape, ff.OUTPUTS) * skip.passes > SKIP_OUTPUTS:
+            last = _last_pattern(skip.shape)
+            if last is not None:
+                self._pattern(last, skip.t_to)
+            return
+        for change in ff.expand(skip.shape, skip.t, skip.period, skip.passes, ff.OUTPUTS,
+                                skip.position, skip.shift):
+            self._pattern(change.pattern, change.t)
+
+    def _moved(self, skip: ev.FastForwarded) -> None:
+        """Skipped passes that move: copies of the pass before them while they are few,
+        else the position where they start and where the last one ends, nothing between."""
+        self._follow(skip.t)
+        span, moved = skip.t_to - skip.t, skip.passes * skip.shift
+        if not self._copied(skip):
+            self.trace.position += [(skip.t, float(skip.position)),
+                                    (skip.t_to, float(skip.position + moved))]
+            self.trace.target.append((skip.t_to, self.trace.target[-1][1] + moved))
+        # a move running across the skip's end runs on as the copy of the one before it
+        self.segments = tuple(replace(seg, t0=seg.t0 + span, x0=seg.x0 + moved)
+                              for seg in self.segments)
+        self.sampled_to = skip.t_to
+
+    def _copied(self, skip: ev.FastForwarded) -> bool:
+        """The positions and targets of skipped passes drawn as those of the pass before
+        them, each `shift` further (the passes are copies: vm/fastforward.py); False
+        when that pass has no samples or the copies would be more than COPIED."""
+        before = skip.t - skip.period
+        last = _since(self.trace.position, before, skip.t)
+        if not last or len(last) * skip.passes > COPIED:
+            return False
+        for into, pass_ in ((self.trace.position, last),
+                            (self.trace.target, _since(self.trace.target, before, skip.t))):
+            into += [(t + k * skip.period, x + k * skip.shift)
+                     for k in range(1, skip.passes + 1) for t, x in pass_]
+        return True
 
     def _follow(self, t: float) -> None:
         """Position samples of the running profile up to t: CURVE points along each
@@ -199,6 +243,15 @@ class PlotObserver:
         if self.trace.ended is not None and not self.segments:  # a move still running is no idle
             self.trace.idle_from = max([self.trace.ended, *self.trace.actions[-1:]])
         return self.trace
+
+
+def _since(samples: list, a: float, b: float) -> list:
+    """The (t, value) samples with a <= t < b (samples in time order)."""
+    return samples[bisect_left(samples, a, key=_time):bisect_left(samples, b, key=_time)]
+
+
+def _time(sample: tuple) -> float:
+    return sample[0]
 
 
 def _last_pattern(shape: tuple) -> int | None:
@@ -309,17 +362,32 @@ def span(us: float) -> str:
 
 def figure(trace: Trace, title: str = ""):
     """A matplotlib figure of the trace: position over the lanes, one shared time axis."""
-    plt = _pyplot()
-    plt.rcParams["svg.fonttype"] = "none"  # text stays text in an SVG (searchable, testable)
-    plt.rcParams["svg.hashsalt"] = "mercmac"  # the same run gives the same file
+    plt = styled()
     axis = _time_axis(trace)
     inputs = sorted(set(trace.inputs) | {1, 2, 3, 4})
     fig, axes = plt.subplots(4, 1, sharex=True, figsize=(11, 6.5), layout="constrained",
                              gridspec_kw={"height_ratios": [5, 0.45 * len(inputs), 1.8, 0.8]})
-    _position(axes[0], trace, axis)
-    _bars(axes[1], trace.inputs, inputs, axis, "tab:blue", "buttons")
-    _bars(axes[2], trace.outputs, [1, 2, 3, 4], axis, "tab:orange", "LEDs")
-    _macros(axes[3], trace.macros, axis)
+    position(axes[0], trace, axis)
+    bars(axes[1], trace.inputs, inputs, axis, "tab:blue", "buttons")
+    bars(axes[2], trace.outputs, [1, 2, 3, 4], axis, "tab:orange", "LEDs")
+    macros(axes[3], trace.macros, axis)
+    time_lanes(axes, axis)
+    if title:
+        fig.suptitle(title, fontsize=11)
+    return fig
+
+
+def styled():
+    """pyplot, set to make files that are the same for the same run."""
+    plt = _pyplot()
+    plt.rcParams["svg.fonttype"] = "none"  # text stays text in an SVG (searchable, testable)
+    plt.rcParams["svg.hashsalt"] = "mercmac"  # the same run gives the same file
+    return plt
+
+
+def time_lanes(axes, axis: TimeAxis) -> None:
+    """Lanes on one time axis (top first): the compressed stretches hatched across all,
+    labelled on the top one, the real times ticked on the bottom one."""
     bands = _spans(axis, axis.stretches)
     hatch = _hatch(bands, axis)
     for ax in axes:
@@ -329,9 +397,6 @@ def figure(trace: Trace, title: str = ""):
     axes[-1].set_xticks(where, text)
     axes[-1].set_xlim(0, axis.drawn[-1])
     axes[-1].set_xlabel("time" + _broken(axis))
-    if title:
-        fig.suptitle(title, fontsize=11)
-    return fig
 
 
 def _time_axis(trace: Trace) -> TimeAxis:
@@ -345,7 +410,8 @@ def _broken(axis: TimeAxis) -> str:
     return f" (hatched: {' or '.join(kinds)}, drawn compressed)" if kinds else ""
 
 
-def _position(ax, trace: Trace, axis: TimeAxis) -> None:
+def position(ax, trace: Trace, axis: TimeAxis) -> None:
+    """Position and target over time; far targets as arrows on the edge, hazards marked."""
     t, x = zip(*trace.position)
     ax.plot(axis(t), x, color="tab:blue", lw=1.6, label="position")
     t, x = zip(*trace.target)
@@ -446,7 +512,7 @@ def _fit(label, room: tuple[float, float], texts: tuple[str, ...]) -> None:
     label.draw = draw
 
 
-def _bars(ax, lanes: dict, rows: list, axis: TimeAxis, color: str, name: str) -> None:
+def bars(ax, lanes: dict, rows: list, axis: TimeAxis, color: str, name: str) -> None:
     for y, n in enumerate(rows):
         spans = _spans(axis, lanes.get(n, ()))
         _lane(ax, spans, [color] * len(spans), (y + 0.15, 0.7), axis)
@@ -501,7 +567,7 @@ def _coarse(spans: list, keys: list, step: float) -> tuple[list, list]:
     return out_spans, out_keys
 
 
-def _macros(ax, macros: list, axis: TimeAxis) -> None:
+def macros(ax, macros: list, axis: TimeAxis) -> None:
     import matplotlib
 
     tab20 = matplotlib.colormaps["tab20"]
@@ -569,8 +635,13 @@ def _band_labels(ax, axis: TimeAxis, bands: list) -> None:
 
 def write(path: str, trace: Trace, title: str = "") -> None:
     """The plot into PATH (whole or not at all), its kind from the ending."""
+    save(path, figure(trace, title), lambda: data(trace), title)
+
+
+def save(path: str, fig, data_of, title: str = "", lanes: str = "") -> None:
+    """A figure into PATH (whole or not at all), its kind from the ending, then closed;
+    an HTML page also holds `data_of()` and says what `lanes` are drawn."""
     plt = _pyplot()
-    fig = figure(trace, title)
     kind = os.path.splitext(path)[1].lower().lstrip(".")
     try:
         if kind == "html":
@@ -578,7 +649,7 @@ def write(path: str, trace: Trace, title: str = "") -> None:
 
             svg = io.StringIO()
             fig.savefig(svg, format="svg", metadata={"Date": None})
-            page = plot_html.page(svg.getvalue(), data(trace), title)
+            page = plot_html.page(svg.getvalue(), data_of(), title, lanes)
             with replacing(path) as f:
                 f.write(page)
         else:

@@ -50,7 +50,7 @@ p.help {{ color: #555; font-size: 90%; }}
 </head>
 <body>
 <h1 style="font-size: 120%">{title}</h1>
-<p class="help">Lanes: position, buttons, LEDs, macro. Hatched: time drawn compressed
+<p class="help">Lanes: {lanes}. Hatched: time drawn compressed
 (fast-forwarded, or idle after the program ended); a red arrow on an edge: a target beyond
 the position axis. Wheel: zoom; drag: pan; double-click or 0: the whole run.</p>
 <div id="plot">
@@ -63,10 +63,14 @@ the position axis. Wheel: zoom; drag: pan; double-click or 0: the whole run.</p>
 """
 
 
-def page(svg: str, data: dict, title: str = "") -> str:
-    """The HTML page around an SVG plot (matplotlib's), with its data as JSON."""
+LANES = "position, buttons, LEDs, macro"  # a single controller's plot (plot.py)
+
+
+def page(svg: str, data: dict, title: str = "", lanes: str = "") -> str:
+    """The HTML page around an SVG plot (matplotlib's), with its data as JSON; `lanes`
+    says what the picture shows (a rig's differs)."""
     body = re.sub(r"^<\?xml[^>]*\?>\s*(<!DOCTYPE[^>]*>\s*)?", "", svg)
     # `</` cannot end the JSON block early: `<\\/` is the same JSON string
     text = json.dumps(data, separators=(",", ":")).replace("</", "<\\/")
     return _PAGE.format(title=html.escape(title or "mercmac sim"), svg=body, data=text,
-                        script=_SCRIPT)
+                        script=_SCRIPT, lanes=html.escape(lanes or LANES))

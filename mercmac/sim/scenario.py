@@ -51,6 +51,7 @@ class Step:
     at_ms: int
     press: tuple[int, ...]
     release: tuple[int, ...]
+    controller: str | None = None  # a rig's controller (sim/rig_scenario.py); None: the box's
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,6 +60,7 @@ class Expect:
     start_ms: int
     end_ms: int
     checks: dict
+    controller: str | None = None  # a rig's controller (sim/rig_scenario.py)
 
     def describe(self) -> str:
         when = (f"at {self.start_ms} ms" if self.start_ms == self.end_ms
@@ -188,21 +190,31 @@ def _nearest(word: str, known) -> str | None:
 
 
 def _step(i: int, raw: dict) -> Step:
-    _refuse_unknown(f"step {i}: ", raw, ("at", "press", "release"),
-                    "a step has at, press and release")
+    _refuse_unknown(f"step {i}: ", raw, ("at", "press", "release", "controller"),
+                    "a step has at, press and release (and in a rig, controller)")
     if "at" not in raw:
         raise ScenarioError(f"step {i}: write at = \"1s\" with press = [..] and/or "
                             "release = [..]")
     return Step(_duration(f"step {i}: at", raw["at"]),
                 _inputs(f"step {i}: press", raw.get("press", [])),
-                _inputs(f"step {i}: release", raw.get("release", [])))
+                _inputs(f"step {i}: release", raw.get("release", [])),
+                _controller(f"step {i}", raw))
+
+
+def _controller(where: str, raw: dict) -> str | None:
+    """`controller = "y"`: which controller of a rig a step or an expectation is about."""
+    name = raw.get("controller")
+    if name is not None and not (isinstance(name, str) and name.strip()):
+        raise ScenarioError(f"{where}: controller = {_show(name)}: expected the name of a "
+                            "controller of the rig, e.g. controller = \"y\"")
+    return name
 
 
 def _expect(i: int, raw: dict) -> Expect:
-    _refuse_unknown(f"expect {i}: ", raw, ("at", "within") + CHECKS,
+    _refuse_unknown(f"expect {i}: ", raw, ("at", "within", "controller") + CHECKS,
                     f"an expectation has at or within, and {', '.join(CHECKS)}")
     checks = {k: v for k, v in raw.items() if k in CHECKS}
-    timing = set(raw) - set(checks)
+    timing = set(raw) - set(checks) - {"controller"}
     if not checks or timing not in ({"at"}, {"within"}):
         raise ScenarioError(f"expect {i}: give `at` or `within` and one or more of "
                             f"{', '.join(CHECKS)}")
@@ -218,7 +230,7 @@ def _expect(i: int, raw: dict) -> Expect:
             raise ScenarioError(f"expect {i}: the window ends before it starts")
     for key, value in checks.items():
         _validate(i, key, value)
-    return Expect(i, start, end, checks)
+    return Expect(i, start, end, checks, _controller(f"expect {i}", raw))
 
 
 EXPECTED = {  # what each check takes, and how to say so
@@ -326,6 +338,10 @@ def next_change_ms(m: Machine) -> float:
 
 def run(m: Machine, scenario: Scenario, until_ms: int) -> int:
     """Power on, play the steps, check every expectation in time order; the number checked."""
+    named = next((e for e in [*scenario.steps, *scenario.expects] if e.controller), None)
+    if named is not None:
+        raise ScenarioError(f"{scenario.name}: controller = {_show(named.controller)} is for "
+                            "a rig file (*.rig.toml); this run has one controller")
     check_names(m, scenario)
     schedule_steps(m, scenario)
     m.power_on()

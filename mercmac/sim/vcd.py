@@ -37,18 +37,23 @@ class _Counted:
 class VcdObserver:
     """An event listener that writes value changes; call `close(t_us)` at the end."""
 
-    def __init__(self, stream: IO[str], limit: int | None = None):
-        self.out = _Counted(stream)
+    def __init__(self, stream: IO[str] | None, limit: int | None = None, *,
+                 writer=None, scope: str = ""):
+        """`writer` and `scope`: one controller of a rig writing into a shared dump (its
+        scopes under `scope`, sim/rig_vcd.py); else a dump of its own on `stream`."""
+        self.out = _Counted(stream) if writer is None else _Counted(None)
         self.limit = limit
         self.cut_at: int | None = None  # us: where the dump stopped at the size limit
-        self.writer = VCDWriter(self.out, timescale="1 us", date="", comment="mercmac sim")
+        self.writer = writer or VCDWriter(self.out, timescale="1 us", date="",
+                                          comment="mercmac sim")
         reg = self.writer.register_var
-        self.inputs = [None] + [reg("box", f"in{n}", "wire", size=1, init=0) for n in range(1, 7)]
-        self.outputs = [reg("box", f"out{n}", "wire", size=1, init=0) for n in range(1, 5)]
-        self.position = reg("axis", "position", "integer", size=32, init=0)
-        self.target = reg("axis", "target", "integer", size=32, init=0)
-        self.macro = reg("vm", "macro", "reg", size=6, init="z")
-        self.skipping = reg("vm", "fast_forward", "wire", size=1, init=0)
+        box, axis, vm = (f"{scope}.{s}" if scope else s for s in ("box", "axis", "vm"))
+        self.inputs = [None] + [reg(box, f"in{n}", "wire", size=1, init=0) for n in range(1, 7)]
+        self.outputs = [reg(box, f"out{n}", "wire", size=1, init=0) for n in range(1, 5)]
+        self.position = reg(axis, "position", "integer", size=32, init=0)
+        self.target = reg(axis, "target", "integer", size=32, init=0)
+        self.macro = reg(vm, "macro", "reg", size=6, init="z")
+        self.skipping = reg(vm, "fast_forward", "wire", size=1, init=0)
         self.segments: tuple = ()
         self.sampled_to = 0
         self.last = 0

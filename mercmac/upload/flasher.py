@@ -159,14 +159,15 @@ def flash_file(port: str, path: str, *, address: int | None = 0, baud: int = DEF
             result = flash(c, who, program, options, notify)
             result.restoring = _is_backup(path)
             if not options.dry_run:
-                result.recorded = _record(c, who, compiled, result)
+                result.recorded = record(c, who, compiled, result)
             watch.finished(result)
     return result
 
 
-def _record(controller: Controller, identity: Identity, compiled: Compilation,
-            result: FlashResult) -> Path | None:
-    """Note the verified flash in the history (mercmac.upload.history); None if it cannot be."""
+def record(controller: Controller, identity: Identity, compiled: Compilation,
+           result: FlashResult, rig=None) -> Path | None:
+    """Note the verified flash in the history (mercmac.upload.history); None if it cannot be.
+    `rig`: a history.InRig when the controller was flashed as part of a rig."""
     from mercmac import outfile
     from mercmac.upload import history
 
@@ -175,7 +176,7 @@ def _record(controller: Controller, identity: Identity, compiled: Compilation,
                               model=identity.version.model, firmware=identity.version.firmware,
                               file=compiled.source.name, source=compiled.source.text,
                               build=compiled.program.md_lines(),
-                              backup_path=result.backup)
+                              backup_path=result.backup, rig=rig)
     except (OSError, outfile.OutputError) as e:
         # the flash is done and verified; a history that cannot be written is no failure,
         # but `pull` will not give this source back: the summary says so (issue 20, item 17)
@@ -207,6 +208,16 @@ def _compile(path: str, target: str | None, watch: Watch) -> Compilation:
 def flash(controller: Controller, identity: Identity, program: Program,
           options: FlashOptions, notify: Notify = lambda e: None) -> FlashResult:
     """Read back, back up, write and verify; FlashFailed names the state on any failure."""
+    result = prepare(controller, identity, program, options, notify)
+    if not options.dry_run:
+        write(controller, result, notify)
+    return result
+
+
+def prepare(controller: Controller, identity: Identity, program: Program,
+            options: FlashOptions, notify: Notify = lambda e: None) -> FlashResult:
+    """Read back, plan and (unless a dry run) back up: nothing is written yet. A rig backs up
+    every controller this way before it writes to any (mercmac.upload.rig)."""
     result = None
     try:
         stored = controller.read_all()  # TM, TZ (SPEC §4 rule 3)
@@ -223,11 +234,15 @@ def flash(controller: Controller, identity: Identity, program: Program,
         saved = f"; backup: {result.backup}" if result and result.backup else ""
         raise FlashInterrupted(f"interrupted before the first write; nothing was written{saved}") \
             from None
-    run = _Run(controller, plan, notify, result)
-    run.execute()
-    if options.reset:
-        run.reset()
     return result
+
+
+def write(controller: Controller, result: FlashResult, notify: Notify = lambda e: None) -> None:
+    """Carry out a prepared plan: write, verify, macro 0 last; RT when `result.reset`."""
+    run = _Run(controller, result.plan, notify, result)
+    run.execute()
+    if result.reset:
+        run.reset()
 
 
 def _save_backup(controller: Controller, identity: Identity, stored: dict[int, str],

@@ -50,6 +50,12 @@ class Record:
     source: str  # its whole text, as flashed
     build: list[str]  # the MD lines, slot order, macro 0 last (`mercmac build`)
     backup: PathText | None = None  # the backup of what the controller held before
+    # A controller flashed as part of a rig (mercmac.upload.rig): the rig file's absolute
+    # path, the rig's name and this controller's name in it, so that `pull --rig` gives the
+    # names back. Records of single flashes (and of older mercmacs) have none.
+    rig: PathText | None = None
+    rig_name: str | None = None
+    controller: str | None = None
 
     @property
     def name(self) -> str:
@@ -94,18 +100,34 @@ def folder() -> Path:
     return backup.data_dir() / "history"
 
 
+class InRig(NamedTuple):
+    """Where a flashed controller belongs: the rig file, the rig's name, its own name."""
+
+    file: str
+    name: str
+    controller: str
+
+
 def record(*, port: str, address: int, model: str | None, firmware: str, file: str,
            source: str, build: list[str], backup_path: Path | None = None,
-           when: _dt.datetime | None = None) -> Path:
+           when: _dt.datetime | None = None, rig: InRig | None = None) -> Path:
     """Write one record, whole or not at all; outfile.OutputError when it cannot be written."""
     when = (when or _dt.datetime.now()).astimezone()
     shown = file if file.startswith("<") else os.path.abspath(file)
     entry = Record(when.isoformat(timespec="seconds"), port, address, model, firmware, shown,
-                   source, list(build), str(backup_path) if backup_path else None)
+                   source, list(build), str(backup_path) if backup_path else None,
+                   *((os.path.abspath(rig.file), rig.name, rig.controller) if rig else ()))
+    fields = asdict(entry)
+    if rig is None:  # a single flash's record stays readable by mercmacs without rigs
+        for name in _RIG_FIELDS:
+            del fields[name]
     path = _new_path(when, port, address)
-    outfile.write_text(path, json.dumps({"format": FORMAT, **asdict(entry)}, indent=1) + "\n",
+    outfile.write_text(path, json.dumps({"format": FORMAT, **fields}, indent=1) + "\n",
                        make_parents=True)
     return path
+
+
+_RIG_FIELDS = ("rig", "rig_name", "controller")
 
 
 def read() -> Shelf:

@@ -69,6 +69,19 @@ having found the reference, so every later absolute move is off. Use the
 other fixed direction (FE0 / FE1), or FE2 / FE3, which pick the direction from
 the switch state. The simulator places the switch with `sim --reference-at`.""", {
         "": "FE{mode} searches away from the reference switch and runs to the end of travel"}),
+    Rule("MH008", "rig-deadlock", _W, "every controller of a rig waits on a line no one will change",
+         """\
+In a rig (several controllers wired output to input, MS176E §3.8, §4.5.1) a
+macro that waits with WN/WF on a wired input goes on only when the other
+controller changes the output at the far end of the wire. When every
+controller that still runs waits like that, and no move, button or joystick
+is left to change anything, none of them will ever go on: a dead-lock. On the
+bench the stand stops with no error (a controller that waits on a box button
+or the joystick waits for a person instead: no dead-lock). Typical causes: each side waits for the
+other's signal before giving its own (raise your output before you wait), or
+an output is cleared before the other side saw it. `mercmac check` on the rig
+finds wait cycles in the wiring before a run.""", {
+        "": "dead-lock: {waits}; no one will change these lines"}),
 )
 
 _BY_NAME = {r.name: r for r in RULES}

@@ -137,6 +137,7 @@ class Machine:
     limits_high: bool = key()
     shown: int = key()  # the output pattern the listeners last heard of
     mover: ev.Where | None = key()  # the command a limit hit will be blamed on
+    deflection: float | None = key()  # the joystick as set_joystick holds it; None: input 5
     clock: Clock = part()
     outputs: Outputs = part()
     axis: Axis = part(shifts=Axis.unshifted)
@@ -178,6 +179,7 @@ class Machine:
         self.optimiser = Optimiser(self, FastForward(fast_forward))
         self.chunks, self._lines = {}, None
         self.hazards = HazardLog()
+        self.deflection = None  # hardware: a reset leaves the joystick where it is
         self._reset_state()
         if program is not None:
             self.load(program)
@@ -381,6 +383,25 @@ class Machine:
     def run_until(self, t_ms: float) -> None:
         """Advance simulated time to t_ms; motion continues when nothing runs."""
         self.run(round(t_ms * 1000))
+
+    def run_through(self, t: int) -> None:
+        """Process every event and instruction due at or before t (us) and stay at t, so that
+        an input set next happens at t (a rig's wires, sim/rig.py)."""
+        self.run(t + 1)
+        self.clock.now = t
+
+    def set_joystick(self, deflection: float) -> None:
+        """Hold the joystick at `deflection` (-1 full negative .. 1 full positive) from now on.
+
+        §3.6: the joystick sets the axis's velocity, not its position: JN's maximum at full
+        deflection (§6.4 JN), scaled by the response table (§6.4 JT); input 5 reads the
+        joystick ON above mid-scale (lines.py)."""
+        self.deflection = max(-1.0, min(1.0, float(deflection)))
+        on = self.deflection > 0
+        if self.inputs.set(5, on):
+            self._input_changed(5, on)  # which drives the axis when the joystick is on
+        elif self.axis.joystick:
+            self._drive_joystick()
 
     # ---------------------------------------------------------------- the loop
     def run(self, until: int) -> None:
@@ -625,10 +646,21 @@ class Machine:
         self._drive_joystick()
 
     def _drive_joystick(self) -> None:
-        if self.axis.joystick and self.inputs.state[5]:
-            self._motion(ev.Motion.JOYSTICK, lambda t: self.axis.move(t, self.axis.jh, self.axis.joystick))
+        velocity = self.axis.joystick * self._joystick_response()
+        if velocity:
+            end = self.axis.jh if velocity > 0 else self.axis.jl  # soft limits apply (§4.4.2)
+            self._motion(ev.Motion.JOYSTICK, lambda t: self.axis.move(t, end, abs(velocity)))
         elif self.axis.moving(self.clock.now):
             self._motion(ev.Motion.STOP, self.axis.decelerate)
+
+    def _joystick_response(self) -> float:
+        """The share of JN's velocity the joystick asks for: the deflection through the
+        response table (§6.4 JT: 0 linear, 1 cubic, 2 and 3 the same inverted); without
+        set_joystick, input 5 ON is full positive deflection."""
+        d = self.deflection if self.deflection is not None else float(self.inputs.state[5])
+        table = self.params.get(Mnemonic.JT, 1)  # §6.4 JT: cubic is the factory default
+        shaped = d ** 3 if table in (1, 3) else d
+        return -shaped if table in (2, 3) else shaped
 
     # ---------------------------------------------------------------- I/O
     def _set_outputs(self, bits: int) -> None:

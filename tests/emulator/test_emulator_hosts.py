@@ -18,7 +18,7 @@ from mercmac.compiler.program import Op
 from mercmac.emulator.virtual import Faults
 from mercmac.upload import protocol
 from mercmac.vm import Machine, Options, reports
-from helpers.emulator import eventually, raw_port, read_for, serve
+from helpers.emulator import basil_mercury, eventually, raw_port, read_for, serve
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs pseudo-terminals")
 
@@ -287,16 +287,8 @@ def test_emulate_refuses_a_log_that_is_not_a_regular_file(tmp_path, kind):
 @pytest.mark.slow
 @pytest.mark.parametrize("write_termination", ["", "\x03"])  # "\x03": basil's default, an ETX
 def test_basil_daq_mercury_driver(write_termination):
-    dut_module = pytest.importorskip("basil.dut", reason="basil-daq is not installed "
-                                     "(pip install '.[test]' installs it)")
     with serve() as (server, vc):
-        conf = {"transfer_layer": [{"name": "Serial", "type": "Serial", "init": {
-                    "port": server.path, "baudrate": 9600, "timeout": 0.05,
-                    "read_termination": "\x03", "write_termination": write_termination}}],
-                "hw_drivers": [{"name": "Mercury", "type": "mercury", "interface": "Serial"}]}
-        dut = dut_module.Dut(conf)
-        dut.init()  # probes boards 0-15 with two TBs each and reads one answer
-        try:
+        with basil_mercury(server.path, write_termination) as dut:
             mercury = dut["Mercury"]
             assert 0 in mercury._board_numbers
             time.sleep(0.05)
@@ -310,6 +302,4 @@ def test_basil_daq_mercury_driver(write_termination):
             mercury.set_position(3000, board_number=0, wait=True)  # polls TP until it stays
             assert mercury.get_position(0) == 3000
             mercury.abort(0)
-        finally:
-            dut.close()
         assert eventually(server, lambda v: {"MN", "MA5000", "TS", "MA3000", "AB"} <= set(v.lines))

@@ -57,3 +57,41 @@ def read_for(port, seconds: float = 0.15) -> bytes:
     while time.monotonic() < end:
         data += port.read(port.in_waiting or 1)
     return data
+
+
+@contextmanager
+def emulating(*args: str):
+    """`mercmac emulate ARGS` as a process: yields (its first line, the pty path); Ctrl-C ends it."""
+    import signal
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "mercmac", "emulate", *args],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        first = proc.stdout.readline()
+        assert first, proc.stderr.read()
+        yield first, proc.stdout.readline().strip()
+    finally:
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=5) == 130  # Ctrl-C, as `scan` and `sim --interactive`
+
+
+@contextmanager
+def basil_mercury(path: str, write_termination: str):
+    """basil-daq's Dut with its Mercury driver on PATH over its pyserial transport, inited:
+    it probes boards 0-15 with two TBs each and reads one answer (skipped without basil)."""
+    import pytest
+
+    dut_module = pytest.importorskip("basil.dut", reason="basil-daq is not installed "
+                                     "(pip install '.[test]' installs it)")
+    conf = {"transfer_layer": [{"name": "Serial", "type": "Serial", "init": {
+                "port": path, "baudrate": 9600, "timeout": 0.05,
+                "read_termination": "\x03", "write_termination": write_termination}}],
+            "hw_drivers": [{"name": "Mercury", "type": "mercury", "interface": "Serial"}]}
+    dut = dut_module.Dut(conf)
+    dut.init()
+    try:
+        yield dut
+    finally:
+        dut.close()

@@ -1,5 +1,6 @@
 // The client: VS Code starts `mercmac lsp --stdio` (the language server over stdio) for .mcm
-// documents. vscode-languageclient appends `--stdio` itself for TransportKind.stdio.
+// documents and rig files (*.rig.toml). vscode-languageclient appends `--stdio` itself for
+// TransportKind.stdio.
 // Bundled by esbuild into dist/extension.js (`npm run build`), which is what the .vsix holds.
 "use strict";
 const fs = require("fs");
@@ -28,6 +29,9 @@ function clientOptions() {
     documentSelector: [
       { scheme: "file", language: "mcm" },
       { scheme: "untitled", language: "mcm" },
+      // rig files (several controllers on one link): TOML, whatever language an editor
+      // gives them, so matched by name; the server checks them as `mercmac check RIG` does
+      { scheme: "file", pattern: "**/*.rig.toml" },
     ],
     // the server asks for the `mercmac` section (target, select, ignore) through
     // workspace/configuration and is told of changes to it
@@ -112,4 +116,4 @@ function deactivate() {
   return old ? old.stop() : undefined;
 }
 
-module.exports = { activate, deactivate, startFailure, current: () => client };
+module.exports = { activate, deactivate, startFailure, clientOptions, current: () => client };

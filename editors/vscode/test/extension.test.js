@@ -77,7 +77,8 @@ test("a change of mercmac.path restarts the client with the new executable", asy
 
 test("package.json contributes the language, its grammar and the settings", () => {
   const pkg = require("../package.json");
-  assert.deepStrictEqual(pkg.activationEvents, ["onLanguage:mcm"]);
+  assert.deepStrictEqual(pkg.activationEvents,
+    ["onLanguage:mcm", "workspaceContains:**/*.rig.toml"]);
   assert.strictEqual(pkg.main, "./dist/extension.js");
   assert.deepStrictEqual(pkg.contributes.languages[0].extensions, [".mcm"]);
   assert.strictEqual(pkg.contributes.grammars[0].scopeName, "source.mcm");
@@ -95,3 +96,11 @@ async function waitFor(probe, ms = 20000) {
     await new Promise((resolve) => setTimeout(resolve, 50));
   }
 }
+
+test("rig files go to the server too, by name: they are TOML, not mcm", () => {
+  const extension = requireWith(makeVscode({}).vscode, BUNDLE);
+  const selector = extension.clientOptions().documentSelector;
+  assert.ok(selector.some((s) => s.scheme === "file" && s.pattern === "**/*.rig.toml"),
+    JSON.stringify(selector));
+  assert.ok(selector.some((s) => s.language === "mcm"));
+});

@@ -1,0 +1,123 @@
+"""Rigs in the editor (issue 18 §2): a rig file (`*.rig.toml`) gets what `check RIG` reports
+on it, at its positions in the rig file; a `.mcm` that a rig names as a program (a rig file
+in its folder or above) is checked with that controller's model, a `target` line that
+differs from it is reported as the rig rule model-mismatch (MR006) reports it, and it gets
+the rig rules `check RIG` reports in a program (SC in macro 0, an input nothing drives),
+from the editor's text.
+
+The rig's checks are mercmac.rig.checks' (no second rig checker here); this module only
+finds the rig a document belongs to and picks what belongs to the document.
+"""
+from __future__ import annotations
+
+import os
+from typing import Callable, NamedTuple
+
+from mercmac.compiler import Compilation, ast
+from mercmac.compiler.checking import Choice
+from mercmac.diagnostics import RULES, Diagnostic, Report
+from mercmac.rig.load import RigFile, is_rig_path, parse_rig, read_rig
+from mercmac.rig.model import Controller, Rig
+from mercmac.source import Source, read_source
+
+# How many folders up from a program its rig may stand: a rig holds its programs in its
+# own folder or below (paths relative to the rig file), and a walk to the root of a deep
+# tree would read every rig file on the way at each keystroke.
+MAX_LEVELS = 8
+
+__all__ = ["is_rig_path", "Owner", "owner_of", "rig_diagnostics", "with_rig_model",
+           "program_rig_diagnostics"]
+# the rig rules (MR001-...): the rules of the table that are not the compiler's own (MM)
+RIG_CODES = frozenset(r.code for r in RULES if not r.code.startswith("MM"))
+
+
+class Owner(NamedTuple):
+    """The rig file that names a program, and the controller the program runs on."""
+
+    rig_file: RigFile
+    controller: Controller
+
+    @property
+    def rig(self) -> Rig:
+        return self.rig_file.rig
+
+
+def rig_diagnostics(source: Source, choice: Choice) -> list[Diagnostic]:
+    """What `check RIG` reports on the rig file itself (`source`: its name is its path),
+    under `choice`; the programs' own findings belong to their files."""
+    from mercmac.rig.checks import check_rig
+
+    own, *programs = check_rig(parse_rig(source), choice)
+    return own.diagnostics
+
+
+def owner_of(path: str, open_text: Callable[[str], str | None]) -> Owner | None:
+    """The rig in `path`'s folder or above that names it as a program, nearest first;
+    `open_text(rig_path)` is the editor's text of a rig file that is open (unsaved edits
+    count), None for one read from disk."""
+    program = os.path.realpath(path)
+    for folder in _folders(os.path.dirname(program)):
+        for rig_path in _rig_files(folder):
+            rig_file = _rig_file(rig_path, open_text(rig_path))
+            rig = rig_file.rig if rig_file else None
+            found = rig and next((c for c in rig.controllers
+                                  if os.path.realpath(c.program) == program), None)
+            if found:
+                return Owner(rig_file, found)
+    return None
+
+
+def _folders(start: str):
+    folder = start
+    for _ in range(MAX_LEVELS):
+        yield folder
+        parent = os.path.dirname(folder)
+        if parent == folder:
+            return
+        folder = parent
+
+
+def _rig_files(folder: str) -> list[str]:
+    try:
+        with os.scandir(folder) as entries:
+            return sorted(e.path for e in entries if is_rig_path(e.name) and e.is_file())
+    except OSError:  # a folder we may not read: no rig of ours there
+        return []
+
+
+def _rig_file(path: str, text: str | None) -> RigFile | None:
+    """The rig file at `path` (from `text` when open); None when it cannot be read."""
+    try:
+        return read_rig(path) if text is None else parse_rig(Source(path, text))
+    except OSError:
+        return None
+
+
+def program_rig_diagnostics(owner: Owner, source: Source, choice: Choice) -> list[Diagnostic]:
+    """What the rig rules of `check RIG` report in the program `source` (the editor's text
+    of the owner's controller's program; the rig's other programs as saved)."""
+    from mercmac.rig.checks import check_rig
+
+    program = os.path.realpath(owner.controller.program)
+
+    def read(path: str) -> Source:
+        return source if os.path.realpath(path) == program else read_source(path)
+
+    _, *programs = check_rig(owner.rig_file, choice, read)
+    return [d for found in programs if found.compilation.source is source
+            for d in found.diagnostics if d.rule.code in RIG_CODES]
+
+
+def with_rig_model(compilation: Compilation, owner: Owner, items: tuple) -> Compilation:
+    """`compilation` (made with the controller's model as target) with model-mismatch on
+    each `target` line that names another model, as `check RIG` reports it on the rig."""
+    controller = owner.controller
+    wrong = [i for i in items if isinstance(i, ast.Target)
+             and i.model.upper() != controller.model]
+    if not wrong:
+        return compilation
+    report = Report(compilation.report.file, list(compilation.report.items))
+    for item in wrong:
+        report.add("model-mismatch", item.span, controller=controller.name,
+                   model=controller.model, target=item.model)
+    return compilation._replace(report=report)

@@ -1,0 +1,248 @@
+"""Reading a rig file: NAME.rig.toml -> a Rig, or the diagnostics of what is wrong with the
+file itself (MR001 rig-file, MR003 rig-wire), each at its line and column (issue 18).
+
+The file is read as the settings files are (mercmac.config): a regular file, at most
+mercmac.source.MAX_BYTES, UTF-8 with an optional byte-order mark. A key mercmac does not
+know is an error, not passed over: a misspelled `adress` must not leave a default.
+"""
+from __future__ import annotations
+
+import os
+import re
+from typing import Any, NamedTuple
+
+from mercmac.commands import MODELS
+from mercmac.diagnostics import Report
+from mercmac.rig.locate import Places, locate
+from mercmac.rig.model import Controller, Line, LineKind, Rig, Wire
+from mercmac.source import Source, Span, read_bytes, split_lines, to_lf
+from mercmac.suggest import suggest
+
+SUFFIX = ".rig.toml"
+TOP_KEYS = ("name", "box", "box_buttons", "wires", "joystick", "controllers")
+CONTROLLER_KEYS = ("address", "model", "program")
+BRANCHES = ("X", "Y", "Z")  # C-819.20 (X, Y through the Y-cable) and C-819.30 (X, Y, Z), §3.6
+BUTTONS = (1, 2, 3, 4)  # the C-170.PB box: button n on input n (MS176E §4.5.1)
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+_WIRE = re.compile(r"\s*(\w+)\.(in|out)(\d+)\s*(?:->|→)\s*(\w+)\.(in|out)(\d+)\s*\Z")
+_TOML_AT = re.compile(r"\(at (?:line (\d+), column (\d+)|end of document)\)")
+
+
+class RigFile(NamedTuple):
+    """A rig file as read: its text, the rig (None when the file has errors), what is wrong
+    with the file, and where its keys stand."""
+
+    source: Source
+    rig: Rig | None
+    report: Report
+    places: Places
+
+
+def is_rig_path(path: str) -> bool:
+    """True for a file named like a rig (`*.rig.toml`, any case)."""
+    return str(path).lower().endswith(SUFFIX)
+
+
+def read_rig(path: str) -> RigFile:
+    """The rig in the file at `path`; OSError when it cannot be read at all."""
+    data = read_bytes(path)
+    try:
+        text = data.decode("utf-8-sig")  # a leading BOM is read past, as config.py does
+    except UnicodeDecodeError as e:
+        source = Source(path, data.decode("utf-8", errors="replace"))
+        return _refused(source, _line_of(data, e.start), "not UTF-8 (TOML files are UTF-8): "
+                        f"byte 0x{data[e.start]:02X}")
+    return parse_rig(Source(path, text))
+
+
+def parse_rig(source: Source) -> RigFile:
+    """The rig that `source` (a rig file's text) describes."""
+    table, problem = _toml(source.text)
+    if problem is not None:
+        return _refused(source, *problem)
+    reader = _Reader(source, locate(source.text))
+    rig = reader.rig(table)
+    return RigFile(source, None if reader.report.has_errors else rig, reader.report,
+                   reader.places)
+
+
+def _refused(source: Source, span: Span, error: str) -> RigFile:
+    report = Report(source.name)
+    report.add("rig-file", span, "toml", error=error)
+    return RigFile(source, None, report, Places({}, {}))
+
+
+def _end(text: str) -> Span:
+    """Where a file that ends too early ends."""
+    lines = split_lines(text) or [""]
+    return Span(len(lines), len(lines[-1]) + 1)
+
+
+def _line_of(data: bytes, offset: int) -> Span:
+    return Span(data[:offset].count(b"\n") + 1, 1)
+
+
+def _toml(text: str) -> tuple[dict, tuple[Span, str] | None]:
+    """The TOML table of `text`, or the span and words of why it is no TOML."""
+    import tomllib
+
+    try:
+        return tomllib.loads(to_lf(text)), None  # CR line ends too (SPEC §5), same lines
+    except tomllib.TOMLDecodeError as e:
+        at = _TOML_AT.search(str(e))
+        span = Span(int(at.group(1)), int(at.group(2))) if at and at.group(1) else _end(text)
+        return {}, (span, _TOML_AT.sub("", str(e)).strip())
+    except RecursionError:  # tomllib reads nested arrays by recursion
+        return {}, (Span(1, 1), "arrays or tables nested too deeply to read")
+
+
+class _Reader:
+    """Reads the TOML table of one rig file into a Rig, reporting what it cannot take."""
+
+    def __init__(self, source: Source, places: Places):
+        self.source, self.places = source, places
+        self.report = Report(source.name)
+        self.folder = os.path.dirname(os.path.abspath(source.name))
+
+    def rig(self, table: dict) -> Rig:
+        self._known(table, TOP_KEYS, ())
+        tables = self._typed(table, "controllers", dict, "a table", {})
+        controllers = self._controllers(tables)
+        names = {name for name in tables if _NAME.match(name)}  # also those with errors
+        return Rig(os.path.abspath(self.source.name), self._name(table), controllers,
+                   box=self._box(table, names), box_buttons=self._buttons(table),
+                   joystick=self._joystick(table, names), wires=self._wires(table, names))
+
+    # -- the parts --------------------------------------------------------------------------
+
+    def _name(self, table: dict) -> str:
+        stem = os.path.basename(self.source.name)
+        default = stem[:-len(SUFFIX)] if is_rig_path(stem) else stem
+        return self._typed(table, "name", str, "a string", default)
+
+    def _controllers(self, tables: dict) -> tuple[Controller, ...]:
+        if not tables and not self.report.has_errors:
+            self.report.add("rig-file", self.places.of("controllers"), "empty")
+        found = []
+        for name, entry in tables.items():
+            path = ("controllers", name)
+            if not _NAME.match(name):
+                self.report.add("rig-file", self.places.of(*path), "name", name=name)
+            elif not isinstance(entry, dict):
+                self._wrong(path, "a table: [controllers.NAME] with address, model, program")
+            else:
+                found.append(self._controller(name, entry))
+        return tuple(c for c in found if c is not None)
+
+    def _controller(self, name: str, entry: dict) -> Controller | None:
+        path = ("controllers", name)
+        self._known(entry, CONTROLLER_KEYS, path)
+        where = f"in [controllers.{name}]"
+        address = self._required(entry, path, "address", int, "a whole number 0-15", where)
+        model = self._required(entry, path, "model", str, " or ".join(MODELS), where)
+        program = self._required(entry, path, "program", str, "a .mcm path", where)
+        if isinstance(model, str) and model.upper() not in MODELS:
+            self._wrong(path + ("model",), " or ".join(MODELS))
+        if None in (address, model, program):
+            return None
+        return Controller(name, address, model.upper(), os.path.join(self.folder, program),
+                          self.places.of(*path))
+
+    def _box(self, table: dict, names: set[str]) -> str | None:
+        box = self._typed(table, "box", str, "a controller's name", None)
+        return self._named(box, ("box",), "box", names)
+
+    def _buttons(self, table: dict) -> tuple[int, ...]:
+        buttons = self._typed(table, "box_buttons", list, "a list of buttons 1-4", list(BUTTONS))
+        for button in buttons:
+            if type(button) is not int or button not in BUTTONS:
+                self.report.add("rig-file", self.places.of("box_buttons"), "button",
+                                button=repr(button))
+        return tuple(b for b in buttons if b in BUTTONS and type(b) is int)
+
+    def _joystick(self, table: dict, names: set[str]) -> dict[str, str]:
+        branches = self._typed(table, "joystick", dict, "a table of branches X, Y, Z", {})
+        found = {}
+        for branch, name in branches.items():
+            path = ("joystick", branch)
+            if branch not in BRANCHES:
+                self.report.add("rig-file", self.places.of(*path), "branch", branch=branch)
+            elif not isinstance(name, str):
+                self._wrong(path, "a controller's name")
+            elif self._named(name, path, f"joystick branch {branch}", names):
+                found[branch] = name
+        return found
+
+    def _wires(self, table: dict, names: set[str]) -> tuple[Wire, ...]:
+        texts = self._typed(table, "wires", list, 'a list of "x.out1 -> y.in1" strings', [])
+        wires = (self._wire(text, self.places.string(("wires",), i), names)
+                 for i, text in enumerate(texts))
+        return tuple(w for w in wires if w is not None)
+
+    def _wire(self, text: Any, span: Span, names: set[str]) -> Wire | None:
+        parsed = _WIRE.match(text) if isinstance(text, str) else None
+        if parsed is None:
+            self.report.add("rig-wire", span, "syntax", text=repr(text))
+            return None
+        where = f"the wire '{text.strip()}'"
+        ends = [self._line(*parsed.group(1, 2, 3), span, where, names),
+                self._line(*parsed.group(4, 5, 6), span, where, names)]
+        if None in ends:
+            return None
+        wire = Wire(ends[0], ends[1], span)
+        if (ends[0].kind, ends[1].kind) != (LineKind.OUT, LineKind.IN):
+            self.report.add("rig-wire", span, "direction", wire=text.strip())
+        elif ends[0].controller == ends[1].controller:
+            self.report.add("rig-wire", span, "loop", wire=str(wire))
+        else:
+            return wire
+        return None
+
+    def _line(self, name: str, kind: str, number: str, span: Span, where: str,
+              names: set[str]) -> Line | None:
+        line = Line(name, LineKind(kind), int(number), span)
+        if not 1 <= line.number <= 4:
+            self.report.add("rig-wire", span, "line", line=str(line), kind=kind + "put")
+        elif self._named(name, ("wires",), where, names, span):
+            return line
+        return None
+
+    # -- keys and types -------------------------------------------------------------------
+
+    def _named(self, name: str | None, path, where: str, names: set[str],
+               span: Span | None = None) -> str | None:
+        """`name` if it is a controller of the rig; else None, reported."""
+        if name is None or name in names:
+            return name
+        close = suggest(name, sorted(names), max(1, len(name) // 3))
+        self.report.add("rig-file", span or self.places.of(*path), "unknown-controller",
+                        where=where, name=name, hint=f"; did you mean '{close}'?" if close else "")
+        return None
+
+    def _known(self, table: dict, keys: tuple[str, ...], path: tuple[str, ...]) -> None:
+        where = f"in [{'.'.join(path)}]" if path else "at the top of the rig file"
+        for key in table:
+            if key not in keys:
+                self.report.add("rig-file", self.places.of(*path, key), "unknown", key=key,
+                                where=where, keys=", ".join(keys))
+
+    def _typed(self, table: dict, key: str, kind: type, expects: str, default):
+        value = table.get(key, default)
+        if value is default or (isinstance(value, kind) and type(value) is not bool):
+            return value
+        self._wrong((key,), expects)
+        return default
+
+    def _required(self, entry: dict, path, key: str, kind: type, expects: str, where: str):
+        if key not in entry:
+            self.report.add("rig-file", self.places.of(*path), "missing", key=key, where=where)
+            return None
+        if not isinstance(entry[key], kind) or type(entry[key]) is bool:
+            self._wrong(path + (key,), expects)
+            return None
+        return entry[key]
+
+    def _wrong(self, path: tuple[str, ...], expects: str) -> None:
+        where = f"in [{'.'.join(path[:-1])}]" if len(path) > 1 else "at the top"
+        self.report.add("rig-file", self.places.of(*path), "type", key=path[-1], where=where,
+                        expects=expects)

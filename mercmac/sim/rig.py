@@ -1,0 +1,262 @@
+"""All controllers of a rig on one simulated clock (issue 18 §3, SPEC §6 `sim RIG`).
+
+Each controller is a Machine of its own (vm/machine.py) running its program; the rig
+advances them together, one instant at a time: the earliest event of any machine, of the
+joystick, or of a button script. MS176E §3.8 and §4.5.1 let axes interact only through
+wired I/O lines, so the wires are all the machines share.
+
+The ordering rule within one instant t (deterministic, and independent of the order of
+the controllers in the rig file):
+  1. every machine due at t processes its hardware events at t, then its command at t;
+     all of them read their inputs as they were before any command at t ran;
+  2. then every wire whose driving output changed takes the output's new level, and its
+     input changes at t (an InputChanged at t on the driven machine);
+  3. a machine that this lets go on (a WN/WF wait that ends) runs its next command at t
+     itself, so 1-3 repeat at t until no machine is due at t any more.
+So an output set at t reaches the wired input at t, before the driven machine runs any
+command after its wait; two commands at the same instant never see each other's outputs
+(as two controllers' clocks are not in step on the bench either).
+"""
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass, replace
+from typing import Iterable, Mapping, Sequence
+
+from mercmac.compiler.program import Program
+from mercmac.rig.model import Rig, Wire
+from mercmac.sim.record import CAP
+from mercmac.sim.rig_ff import JointForward, tell, where
+from mercmac.sim.simulate import DEFAULT_UNTIL_MS, Run, machine_for, schedule
+from mercmac.timespec import Press
+from mercmac.vm import events as ev
+from mercmac.vm.machine import Listener, Machine, Wait
+from mercmac.vm.models import Options
+
+INF = math.inf
+DEADLOCK = "rig-deadlock"  # vm/hazards.py MH008
+
+
+@dataclass(frozen=True, slots=True)
+class Edge:
+    """A wire changed level at t_ms (the driving output's new level)."""
+
+    t_ms: float
+    wire: Wire
+    level: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Hold:
+    """The joystick branch of `controller` held at `deflection` (-1..1) from start_ms to
+    end_ms (None: to the end of the run), then back to the middle."""
+
+    controller: str
+    deflection: float
+    start_ms: float
+    end_ms: float | None = None
+
+
+@dataclass(slots=True)
+class RigRun:
+    """What a rig simulation produced: each controller's Run and the wires' edges."""
+
+    rig: Rig
+    runs: dict[str, Run]
+    edges: list[Edge]
+    until_ms: int
+    edges_dropped: int = 0  # past CAP edges are counted, not listed (as SPEC §5 lists)
+    interrupted: bool = False
+
+    @property
+    def hazards(self) -> int:
+        return sum(len(run.record.hazards) for run in self.runs.values())
+
+
+class RigSim:
+    """The machines of a rig, their wires and the joystick on one clock."""
+
+    def __init__(self, rig: Rig, programs: Mapping[str, Program], *, cycle_ms: float = 1.0,
+                 options: Options | None = None, trace: bool = False,
+                 listeners: Mapping[str, Sequence[Listener]] | None = None,
+                 fast_forward: bool = True):
+        self.rig = rig
+        self.machines: dict[str, Machine] = {}
+        self.records = {}
+        for c in rig.controllers:
+            own = replace(options or Options(), address=c.address)  # TB reports it (§6.4 TB)
+            self.machines[c.name], self.records[c.name] = machine_for(
+                programs[c.name], model=c.model, cycle_ms=cycle_ms, options=own, trace=trace,
+                listeners=(listeners or {}).get(c.name, ()))
+        self.levels = {w: False for w in rig.wires}  # outputs are off at power-on (§3.4)
+        self.by_source = _by_source(rig.wires)
+        self.edges: list[Edge] = []
+        self.edges_dropped = 0
+        self.holds: list[tuple[int, int, str, float]] = []  # (t_us, order, controller, d)
+        self.deadlocked = False
+        self.joint = JointForward(self) if fast_forward and not trace else None
+
+    # ------------------------------------------------------------ what happens to it
+    def press(self, controller: str, presses: Iterable[Press]) -> None:
+        """Buttons of the box pressed on `controller`'s inputs (SPEC §5 `--buttons`)."""
+        schedule(self.machines[controller], presses)
+
+    def hold(self, hold: Hold) -> None:
+        """The joystick deflected on `hold.controller` over a time range (§3.6)."""
+        self._at(hold.start_ms, hold.controller, hold.deflection)
+        if hold.end_ms is not None:
+            self._at(hold.end_ms, hold.controller, 0.0)
+
+    def _at(self, t_ms: float, controller: str, deflection: float) -> None:
+        heapq.heappush(self.holds, (round(t_ms * 1000), len(self.holds), controller, deflection))
+
+    def power_on(self) -> None:
+        """All controllers power on together, at t = 0 or now (a reset of the whole rig;
+        macro 0 starts on each, §3.8.5); their outputs go off, and so do the wires."""
+        for m in self.machines.values():
+            m.power_on()
+        self.deadlocked = False
+        if self.joint is not None:
+            self.joint.seen.clear()  # passes before the reset are no pattern for after it
+        self._propagate(round(self.now_ms() * 1000))
+
+    # ------------------------------------------------------------ the clock
+    def run_until(self, until_ms: float) -> None:
+        """Advance every machine to until_ms, instant by instant (the module's rule)."""
+        until = round(until_ms * 1000)
+        while not self.deadlocked:
+            t = self.next_us()
+            if t >= until:
+                break
+            self._instant(t)
+            if self.joint is not None:
+                self.joint.arrive(t, until)
+        for m in self.machines.values():
+            m.run(until)
+
+    def next_us(self) -> float:
+        """The earliest event of any machine or of the joystick; inf when none is left."""
+        t = min((_next(m) for m in self.machines.values()), default=INF)
+        return min(t, self.holds[0][0]) if self.holds else t
+
+    def _instant(self, t: int) -> None:
+        self._joystick(t)
+        due = [m for m in self.machines.values() if _next(m) <= t]
+        while due:
+            for m in due:
+                m.run_through(t)
+            self._propagate(t)
+            due = [m for m in self.machines.values() if _next(m) <= t]
+        if self.next_us() == INF:
+            self._check_deadlock(t)
+
+    def _joystick(self, t: int) -> None:
+        while self.holds and self.holds[0][0] <= t:
+            _, _, name, deflection = heapq.heappop(self.holds)
+            m = self._at_time(name, t)
+            m.set_joystick(deflection)
+
+    def _at_time(self, name: str, t: int) -> Machine:
+        """The machine `name`, its clock brought to t (nothing of it is due before t)."""
+        m = self.machines[name]
+        if m.now_us < t:
+            m.run(t)
+        return m
+
+    def _propagate(self, t: int) -> None:
+        """Every wire takes its driving output's level at t; changed inputs change at t."""
+        for name, wires in self.by_source.items():
+            pattern = self.machines[name].outputs.pattern(t)
+            for wire in wires:
+                level = bool(pattern >> (wire.source.number - 1) & 1)
+                if level != self.levels[wire]:
+                    self.levels[wire] = level
+                    self.add_edge(Edge(t / 1000, wire, level))
+                    self._at_time(wire.target.controller, t).set_input(wire.target.number, level)
+
+    def add_edge(self, edge: Edge) -> None:
+        """Keep an edge, up to CAP; past it, count it."""
+        if len(self.edges) < CAP:
+            self.edges.append(edge)
+        else:
+            self.edges_dropped += 1
+
+    # ------------------------------------------------------------ dead-lock (MH008)
+    def _check_deadlock(self, t: int) -> None:
+        """Nothing is due any more: when every controller that still runs waits on a wired
+        input, each waits for good. One that waits on a box button or the joystick waits
+        for a person, who may still come: no dead-lock."""
+        running = {name: m for name, m in self.machines.items() if m.running}
+        waiting = {name: m for name, m in running.items() if self._waits_on_wire(name, m)}
+        if not waiting or len(waiting) < len(running):
+            return
+        self.deadlocked = True
+        waits = "; ".join(self._waiting_text(name, m) for name, m in waiting.items())
+        for name, m in waiting.items():
+            message = m.hazards.add(DEADLOCK, (name,), waits=waits)
+            if message is not None:
+                tell(m, ev.HazardFound(t, DEADLOCK, message, where(m)))
+
+    def _waits_on_wire(self, name: str, m: Machine) -> bool:
+        block = m.block
+        return (block is not None and block.wait is not Wait.WS
+                and bool(self.rig.drivers(name, block.arg)))
+
+    def _waiting_text(self, name: str, m: Machine) -> str:
+        block = m.block
+        word = "ON" if block.wait is Wait.WN else "OFF"
+        source = " or ".join(str(w.source) for w in self.rig.drivers(name, block.arg))
+        return (f"{name} waits in {m.label} at {block.wait.name}{block.arg} for in{block.arg} "
+                f"{word} (from {source})")
+
+    def run(self, until_ms: int) -> RigRun:
+        """Power on and run to until_ms; Ctrl-C ends the run where it is (`interrupted`)."""
+        self.power_on()
+        try:
+            self.run_until(until_ms)
+        except KeyboardInterrupt:
+            return self.result(round(self.now_ms()), interrupted=True)
+        return self.result(until_ms)
+
+    def now_ms(self) -> float:
+        """Where the rig's clock stands: the machines that lag (none runs ahead of it)."""
+        return min(m.now_ms for m in self.machines.values())
+
+    # ------------------------------------------------------------ the result
+    def result(self, until_ms: int, interrupted: bool = False) -> RigRun:
+        runs = {name: Run(m, self.records[name], until_ms, interrupted=interrupted)
+                for name, m in self.machines.items()}
+        return RigRun(self.rig, runs, self.edges, until_ms, self.edges_dropped, interrupted)
+
+
+def _by_source(wires: Iterable[Wire]) -> dict[str, list[Wire]]:
+    grouped: dict[str, list[Wire]] = {}
+    for wire in wires:
+        grouped.setdefault(wire.source.controller, []).append(wire)
+    return grouped
+
+
+def _next(m: Machine) -> float:
+    """The machine's next event in us (inf: none)."""
+    t = m.next_event_ms()
+    return t if t == INF else round(t * 1000)
+
+
+
+
+def simulate_rig(rig: Rig, programs: Mapping[str, Program], *,
+                 presses: Mapping[str, Iterable[Press]] | None = None,
+                 holds: Iterable[Hold] = (), until_ms: int = DEFAULT_UNTIL_MS,
+                 cycle_ms: float = 1.0, options: Options | None = None, trace: bool = False,
+                 listeners: Mapping[str, Sequence[Listener]] | None = None,
+                 fast_forward: bool = True) -> RigRun:
+    """Power every controller on at t = 0 and run the rig to until_ms.
+    Ctrl-C ends the run where it is: the RigRun is marked `interrupted`."""
+    sim = RigSim(rig, programs, cycle_ms=cycle_ms, options=options, trace=trace,
+                 listeners=listeners, fast_forward=fast_forward)
+    for name, script in (presses or {}).items():
+        sim.press(name, script)
+    for hold in holds:
+        sim.hold(hold)
+    return sim.run(until_ms)

@@ -1,0 +1,264 @@
+"""Fast-forward for a whole rig: skip the passes that the rig as a whole repeats.
+
+One machine's fast-forward (vm/optimiser.py) sees only its own state, and a machine that
+waits on a wired input cannot know when the other side will answer; so in a rig each
+machine runs instant by instant (sim/rig.py) and this module compares the joint state.
+
+A joint anchor is an instant after which every axis rests on a whole-count target, with no
+trigger set, no trigger pulse on, no JT table being made. The joint key there is every
+machine's state key (vm/statekey.py) without position and target (`unshifted`), its input
+lines, its next command relative to now, and every wire's level. When the key comes back,
+the rig passed through a pass; when two passes in a row have the same shape (per machine:
+moves, arrivals, reports, output changes relative to the pass's start time and position,
+fastforward.moved_shape) and the same shifts, the next passes are copies, each `period`
+later and `delta` further on per axis, until a button or joystick change, the end of the
+run, or a boundary of a shifted move (a soft limit, a switch, an arrival that could round
+to another microsecond: fastforward.shifted_passes) — the rules of the single machine,
+applied to all at once. What a pass does that cannot shift exactly (a hazard, a search, a
+limit hit, a report while moving) makes its shape None, and the rig steps it.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from mercmac.sim.record import CAP
+from mercmac.vm import events as ev
+from mercmac.vm import fastforward as ff
+from mercmac.vm.machine import Machine
+
+if TYPE_CHECKING:
+    from mercmac.sim.rig import RigSim
+
+INF = math.inf
+EXACT_US = 2 ** 53  # below this, sums of whole floats are exact (_whole)
+SEEN_LIMIT = 4096  # joint keys remembered; a rig whose state never repeats forgets them
+_BLOCK = Machine.STATE_KEY.index("block")
+_COUNTERS = Machine.STATE_KEY.index("counters")
+
+
+@dataclass(slots=True)
+class JointVisit:
+    """The rig at one joint anchor."""
+
+    t: int
+    positions: tuple[int, ...]
+    logged: tuple[int, ...]  # each machine's effect log length (its optimiser's)
+    edges: int  # edges so far, listed or not
+    external: float  # the next button or joystick change
+    counters: tuple = ()  # every machine's RP counters, {(slot, ip): value}
+    shapes: tuple | None = None  # per machine, the pass that ended here; None: unknown
+    deltas: tuple[int, ...] | None = None
+    spent: tuple | None = None  # per machine, how much the pass counted each RP down
+
+
+class JointForward:
+    """Compares the rig at its joint anchors and skips repeating passes."""
+
+    def __init__(self, sim: RigSim):
+        self.sim = sim
+        self.machines = list(sim.machines.values())
+        self.seen: dict[tuple, JointVisit] = {}
+
+    def arrive(self, t: int, until: int) -> None:
+        """After the instant t: compare the rig with its last visit of the same key."""
+        key = self._key(t)
+        if key is None:
+            return
+        visit = JointVisit(t, tuple(m.axis.target for m in self.machines), self._logged(),
+                           len(self.sim.edges) + self.sim.edges_dropped, self._external(),
+                           tuple(_counters(m) for m in self.machines))
+        previous = self.seen.get(key)
+        if len(self.seen) >= SEEN_LIMIT:
+            self.seen.clear()
+        self.seen[key] = visit
+        if previous is None or not self._repeats(previous, visit):
+            return
+        period = t - previous.t
+        passes = min(self._passes(visit, period, min(until, visit.external)), _left(visit))
+        if passes > 0:
+            self._jump(key, previous, visit, period, passes)
+
+    def _repeats(self, previous: JointVisit, visit: JointVisit) -> bool:
+        """Whether the pass that ended at `visit` is the one that ended at `previous` again
+        (its shapes, shifts and RP counts; nothing from outside in it), noting them."""
+        if previous.external != visit.external or visit.external <= visit.t:
+            return False  # a button or the joystick changed something in the pass
+        visit.deltas = tuple(p - q for p, q in zip(visit.positions, previous.positions))
+        visit.spent = tuple(_spent(p, v) for p, v in zip(previous.counters, visit.counters))
+        visit.shapes = self._shapes(previous, visit)
+        return (visit.shapes is not None and visit.shapes == previous.shapes
+                and visit.deltas == previous.deltas and visit.spent == previous.spent
+                and None not in visit.spent)
+
+    # ------------------------------------------------------------ the joint state
+    def _key(self, t: int) -> tuple | None:
+        parts = []
+        for m in self.machines:
+            part = _machine_key(m, t)
+            if part is None:
+                return None
+            parts.append(part)
+        parts.append(tuple(self.sim.levels.values()))
+        return tuple(parts)
+
+    def _logged(self) -> tuple[int, ...]:
+        return tuple(m.optimiser.log_base + len(m.optimiser.log) for m in self.machines)
+
+    def _external(self) -> float:
+        """The next change from outside: a scheduled button or the joystick."""
+        t = min(m.inputs.next_change() for m in self.machines)
+        return min(t, self.sim.holds[0][0]) if self.sim.holds else t
+
+    def _shapes(self, previous: JointVisit, visit: JointVisit) -> tuple | None:
+        """Each machine's pass from `previous` to `visit`, as fastforward.moved_shape sees it
+        (the wires' input changes are left out: the joint key holds the lines)."""
+        shapes = []
+        for i, m in enumerate(self.machines):
+            log, base = m.optimiser.log, m.optimiser.log_base
+            if previous.logged[i] < base:
+                return None  # the log was cut since: the pass is not known whole
+            events = [e for e in log[previous.logged[i] - base:visit.logged[i] - base]
+                      if type(e) is not ev.InputChanged]
+            shape = ff.moved_shape(events, previous.t, previous.positions[i])
+            if shape is None:
+                return None
+            shapes.append(shape)
+        return tuple(shapes)
+
+    def _passes(self, visit: JointVisit, period: int, horizon: float) -> int:
+        """Whole passes that end before `horizon` and clear every machine's boundaries."""
+        fit = max(int(horizon - 1 - visit.t) // period, 0)
+        for i, m in enumerate(self.machines):
+            if fit <= 0:
+                break
+            shape = visit.shapes[i]
+            if not ff.plain(shape):
+                now = ff.Visit(None, visit.t, 0, 0, 0, None, (), visit.positions[i],
+                               visit.deltas[i], _whole(shape))
+                fit = ff.shifted_passes(now, period, fit, m.axis.soft_range(), m.axis.switches())
+        return min(fit, max((EXACT_US - visit.t) // period - 1, 0))
+
+    # ------------------------------------------------------------ the skip
+    def _jump(self, key: tuple, previous: JointVisit, visit: JointVisit, period: int,
+              passes: int) -> None:
+        span = passes * period
+        for i, m in enumerate(self.machines):
+            _shift_machine(m, span, visit.deltas[i] * passes, visit.spent[i], passes)
+            if m.chunk is not None:  # one that runs nothing did nothing in the passes
+                tell(m, ev.FastForwarded(visit.t, visit.t + span, passes, period, _place(m),
+                                          visit.shapes[i], visit.positions[i], visit.deltas[i]))
+        self._repeat_edges(previous, visit, period, passes)
+        after = JointVisit(visit.t + span,
+                           tuple(p + d * passes for p, d in zip(visit.positions, visit.deltas)),
+                           self._logged(), len(self.sim.edges) + self.sim.edges_dropped,
+                           visit.external, tuple(_counters(m) for m in self.machines),
+                           visit.shapes, visit.deltas, visit.spent)
+        self.seen[key] = after
+
+    def _repeat_edges(self, previous: JointVisit, visit: JointVisit, period: int,
+                      passes: int) -> None:
+        """The wires' edges of the skipped passes: listed up to CAP, the rest counted."""
+        sim = self.sim
+        count = visit.edges - previous.edges
+        listed = [e for e in sim.edges if previous.t < round(e.t_ms * 1000) <= visit.t]
+        if len(listed) < count:  # some of the pass's edges were past the cap already
+            sim.edges_dropped += count * passes
+            return
+        for p in range(1, passes + 1):
+            shift_ms = p * period / 1000
+            for edge in listed:
+                sim.add_edge(type(edge)(edge.t_ms + shift_ms, edge.wire, edge.level))
+            if len(sim.edges) >= CAP:
+                sim.edges_dropped += count * (passes - p)
+                return
+
+
+def _whole(shape: tuple) -> tuple:
+    """The shape with the arrival check of every move whose segments last whole
+    microseconds taken off: each starts at a whole us (a command's time), so every float sum
+    of its segments is exact below EXACT_US and it arrives at the same offset in any pass
+    (fastforward._same_arrival, which must assume any float, would stop the skip at once)."""
+    return tuple(item._replace(dts=()) if _whole_move(item) else item for item in shape)
+
+
+def _whole_move(item: tuple) -> bool:
+    return (type(item) is ff.Move and item.arrival == sum(item.dts)
+            and all(float(d).is_integer() for d in item.dts))
+
+
+def _machine_key(m: Machine, t: int) -> tuple | None:
+    """One machine's part of the joint key; None unless it rests on a whole-count target with
+    nothing timed going on (a pulse, a trigger, a JT table)."""
+    axis = m.axis
+    if (axis.segs or axis.final != axis.target or m.trigger.mode or m.table_done != INF
+            or m.outputs.pulse_until > t):
+        return None
+    if m.chunk is None:  # nothing runs: only its axis and outputs go on (a joystick)
+        return ("halted", axis.unshifted(axis.state_key()), m.outputs.state_key(),
+                m.deflection, tuple(m.inputs.state))
+    key = list(m._state_key(None))
+    key[_COUNTERS] = tuple(sorted(_counters(m)))  # which RPs count; by how much: _spent
+    block = m.block
+    if block is not None:  # when it began matters only for the first cycle after
+        key[_BLOCK] = (block.wait, block.arg, min(t - block.began, m.clock.cycle))
+    running = m.chunk is not None and block is None
+    return m.unshifted(tuple(key)), tuple(m.inputs.state), m.wake - t if running else None
+
+
+def _counters(m: Machine) -> dict[tuple[int, int], int]:
+    """The machine's RP counters by (slot, RP's place)."""
+    return {(slot, ip): c for slot, cs in m.counters.items() for ip, c in cs.items()}
+
+
+def _spent(before: dict, after: dict) -> dict | None:
+    """How much a pass counted each RP down; None if one counted up (a loop restarted)."""
+    spent = {place: before[place] - c for place, c in after.items()}
+    return None if any(d < 0 for d in spent.values()) else spent
+
+
+def _left(visit: JointVisit) -> int | float:
+    """Passes before an RP that the pass counts down would end its loop: a pass that counts
+    an RP down by d from c repeats only while every jump in it still jumps (c > d; the
+    machine's rule, SPEC §3 Repeat counters)."""
+    left = math.inf
+    for counters, spent in zip(visit.counters, visit.spent):
+        for place, d in spent.items():
+            if d:
+                left = min(left, (counters[place] - 1) // d)
+    return left
+
+
+def _shift_machine(m: Machine, span: int, moved: int, spent: dict, passes: int) -> None:
+    """Everything of `m` that is a time moves on by `span` us; its axis by `moved` counts; its
+    RP counters down as the skipped passes would have counted them."""
+    for (slot, ip), d in spent.items():
+        m.counters[slot][ip] -= d * passes
+    m.clock.now += span
+    m.wake += span
+    if m.block is not None:
+        m.block = m.block._replace(began=m.block.began + span)
+    if moved:
+        m.axis.rest_at(m.axis.target + moved)
+
+
+def where(m: Machine) -> ev.Where | None:
+    """The command `m` ran last (a blocked machine: its wait), as events name a place."""
+    chunk, ip = m.chunk, m.ip - 1
+    if chunk is None or not 0 <= ip < len(chunk.code):
+        return None
+    return ev.Where(chunk.label, chunk.slot, ip, chunk.spans[ip])
+
+
+def _place(m: Machine) -> ev.Where:
+    """Where a running machine stands in its pass: the command it ran last, or its next."""
+    chunk = m.chunk
+    ip = min(max(m.ip - 1, 0), len(chunk.code) - 1)
+    return ev.Where(chunk.label, chunk.slot, ip, chunk.spans[ip])
+
+
+def tell(m: Machine, event: object) -> None:
+    """An event of the rig's about one machine, heard by that machine's listeners."""
+    for listener in m.listeners:
+        listener(event)

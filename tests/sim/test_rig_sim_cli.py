@@ -1,0 +1,158 @@
+"""`mercmac sim RIG` (issue 18 §3, SPEC §6) through click's CliRunner and as a process:
+named timeline lines, JSON per controller with the wires' edges, buttons by controller,
+the joystick, --fail-on-hazard on a dead-locked rig, a VCD with a scope per controller."""
+from __future__ import annotations
+
+import json
+
+from helpers.cli import mercmac_process, sim
+from helpers.rig_sim import RASTER, rig_of
+
+SPEC_KEYS = {"until_ms", "halted", "final", "reports", "outputs", "hazards", "events"}
+
+
+def test_the_timeline_names_each_controller_and_shows_the_wires():
+    result = sim(RASTER, "--buttons", "x:1@0-100ms", "--until", "3s")
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert any(" x  move to 20000 from 0" in line for line in lines)
+    assert any(" y  move to 500 from 0" in line for line in lines)
+    assert any("wire x.out1 -> y.in1 ON" in line for line in lines)
+    # the wired input is the wire's line, not a "button" of y
+    assert not any(" y  button" in line for line in lines)
+    assert "x Summary" in result.output and "y Summary" in result.output
+
+
+def test_json_has_one_spec_object_per_controller_and_the_edges():
+    result = sim(RASTER, "--buttons", "x:1@0-100ms", "--until", "3s", "--format", "json")
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.output)
+    assert set(out["controllers"]) == {"x", "y"}
+    for run in out["controllers"].values():
+        assert SPEC_KEYS <= set(run) and run["until_ms"] == 3000
+    assert out["controllers"]["y"]["final"]["position"] == 1000
+    assert out["edges"][0] == {"t_ms": 1118, "wire": "x.out1 -> y.in1", "source": "x.out1",
+                               "target": "y.in1", "level": True}
+
+
+def test_buttons_without_a_name_go_to_the_box_controller():
+    named = sim(RASTER, "--buttons", "x:1@0-100ms", "--until", "3s", "--format", "json")
+    plain = sim(RASTER, "--buttons", "1@0-100ms", "--until", "3s", "--format", "json")
+    assert plain.exit_code == 0 and plain.output == named.output
+    idle = json.loads(sim(RASTER, "--until", "3s", "--format", "json").output)
+    assert idle["edges"] == []  # without button 1 the scan never starts
+
+
+def test_buttons_on_an_unknown_controller_are_a_usage_error():
+    result = sim(RASTER, "--buttons", "z:1@0")
+    assert result.exit_code == 2
+    assert "no controller 'z'" in result.output and "x, y" in result.output
+
+
+def test_fail_on_hazard_exits_1_on_a_dead_locked_rig(tmp_path):
+    path = rig_of(tmp_path, "macro hello { WN 2, CN 1 }\nautostart { goto hello }\n",
+                  "macro answer { WN 1, CN 2 }\nautostart { goto answer }\n",
+                  '"x.out1 -> y.in1", "y.out2 -> x.in2"')
+    result = sim(path, "--fail-on-hazard", "--until", "1s")
+    assert result.exit_code == 1
+    assert "dead-lock" in result.output and "hello (MC01)" in result.output
+    assert "answer (MC01)" in result.output and "hazards found (--fail-on-hazard)" in result.output
+    assert sim(path, "--until", "1s").exit_code == 0
+
+
+def test_the_joystick_moves_the_controller_of_its_branch(tmp_path):
+    path = rig_of(tmp_path, "autostart { JN 8000 }\n", "autostart { JN 8000 }\n", "",
+                  '[joystick]\nX = "x"\nY = "y"\n')
+    result = sim(path, "--joystick", "x=+1@1s-2s,Y=-1@1s-2s", "--until", "4s",
+                 "--format", "json")
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.output)["controllers"]
+    assert out["x"]["final"]["position"] > 7000 and out["y"]["final"]["position"] < -7000
+    bad = sim(path, "--joystick", "x=2@1s")
+    assert bad.exit_code == 2 and "from -1 to 1" in bad.output
+
+
+def test_the_joystick_is_for_rigs(tmp_path):
+    single = tmp_path / "a.mcm"
+    single.write_text("autostart { JN 100 }\n", encoding="utf-8")
+    result = sim(single, "--joystick", "x=1@0")
+    assert result.exit_code == 2 and "rig file" in result.output
+
+
+def test_the_vcd_has_a_scope_per_controller(tmp_path):
+    out = tmp_path / "raster.vcd"
+    result = sim(RASTER, "--buttons", "x:1@0-100ms", "--until", "5s", "--vcd", out)
+    assert result.exit_code == 0, result.output
+    text = out.read_text(encoding="ascii")
+    assert "$scope module x $end" in text and "$scope module y $end" in text
+    times = [int(line[1:]) for line in text.splitlines() if line.startswith("#")]
+    assert times == sorted(times) and times[-1] == 5_000_000
+
+
+def test_an_hour_of_the_raster_as_a_process(tmp_path):
+    done = mercmac_process("sim", str(RASTER), "--buttons", "x:1@0-100ms", "--until", "1h",
+                           "--format", "json", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    # 1 row (500 counts) per line: about 2.45 s a pair of lines
+    assert out["controllers"]["y"]["final"]["target"] == 1_470_000
+    assert len(out["edges"]) == 10_000 and out["truncated"]["edges"] > 0
+
+
+SCENARIO = """\
+[[step]]
+at = "0ms"
+press = [1]
+[[step]]
+at = "100ms"
+release = [1]
+[[expect]]
+controller = "y"
+within = ["1s", "1.3s"]
+position = 500
+[[expect]]
+controller = "x"
+at = "1.5s"
+macro = "scan"
+[[expect]]
+controller = "y"
+at = "5s"
+position = POSITION
+"""
+
+
+def test_a_scenario_expects_per_controller(tmp_path):
+    good = tmp_path / "good.toml"
+    good.write_text(SCENARIO.replace("POSITION", "[1900, 2100]"), encoding="utf-8")
+    result = sim(RASTER, "--scenario", good)
+    assert result.exit_code == 0, result.output
+    assert "all 3 expectations met" in result.output
+    bad = tmp_path / "bad.toml"
+    bad.write_text(SCENARIO.replace("POSITION", "[100, 200]"), encoding="utf-8")
+    failed = sim(RASTER, "--scenario", bad)
+    assert failed.exit_code == 1
+    assert "expectation 3 (at 5000 ms) on y failed: position is 2000" in failed.output
+
+
+def test_a_scenario_naming_no_such_controller_is_refused(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text('[[expect]]\ncontroller = "z"\nat = "1s"\nrunning = true\n',
+                    encoding="utf-8")
+    result = sim(RASTER, "--scenario", path)
+    assert result.exit_code == 2 and "no controller of that name (x, y)" in result.output
+
+
+def test_a_controller_in_a_single_controllers_scenario_is_refused(tmp_path):
+    program = tmp_path / "a.mcm"
+    program.write_text("autostart { CN 1 }\n", encoding="utf-8")
+    path = tmp_path / "s.toml"
+    path.write_text('[[expect]]\ncontroller = "y"\nat = "1s"\noutputs = 1\n', encoding="utf-8")
+    result = sim(program, "--scenario", path)
+    assert result.exit_code == 2 and "is for a rig file" in result.output
+
+
+def test_a_program_with_errors_is_not_simulated(tmp_path):
+    path = rig_of(tmp_path, "autostart { MR }\n", "autostart { CN 1 }\n", "")
+    result = sim(path)
+    assert result.exit_code == 1
+    assert "x.mcm:2:" in result.output and "Simulating" not in result.output

@@ -1,0 +1,31 @@
+"""`sim RIG --interactive` (issue 18 §3): the live box on the rig's box controller, through a
+real pseudo-terminal, with every controller on the clock: X's LED 1 goes off only when Y
+answered over the wire."""
+from __future__ import annotations
+
+import sys
+
+import pytest
+
+from helpers.cli import sim
+from helpers.rig_sim import RASTER, rig_of
+from test_sim_interactive import Terminal
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="needs a POSIX pty")
+
+
+@pytest.mark.slow
+def test_the_box_on_x_starts_the_scan_and_y_answers_over_the_wire():
+    term = Terminal("sim", str(RASTER), "--interactive", "--speed", "20", "--hold", "1")
+    term.expect("keys 1-4")
+    term.expect("LEDs ●○○○")  # X swept a line and raised out1 ...
+    term.expect("LEDs ○○○○")  # ... and took it back once Y had stepped and raised out2
+    term.type("q")
+    term.expect("Summary")
+    assert term.close() == 0
+
+
+def test_a_rig_without_a_box_has_no_interactive_box(tmp_path):
+    path = rig_of(tmp_path, "autostart { CN 1 }\n", "autostart { CN 1 }\n", "")
+    result = sim(path, "--interactive")
+    assert result.exit_code == 2 and "box = " in result.output

@@ -1,0 +1,225 @@
+"""`flash RIG` (issue 18 §4): every controller of a rig over one pty, against an emulated
+daisy chain (mercmac.emulator.chain) — the library, the CLI in-process and as a process."""
+from __future__ import annotations
+
+import io
+import re
+import shutil
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+
+from helpers.cli import cli, mercmac_process
+from helpers.emulator import FAST, FAST_TIMING, emulating, eventually
+from helpers.paths import ROOT
+from mercmac.emulator.chain import Chain
+from mercmac.emulator.ptyserver import PtyServer
+from mercmac.emulator.virtual import Faults, VirtualController
+from mercmac.upload import history
+from mercmac.upload.errors import FlashFailed, NotChosen, Refused
+from mercmac.upload.flasher import FlashOptions
+from mercmac.upload.rig import State, flash_rig
+
+RASTER = ROOT / "examples" / "rigs" / "raster"
+
+
+@pytest.fixture
+def rig(tmp_path) -> Path:
+    """The raster example copied where a test may change it: two C-663, addresses 0 and 1."""
+    folder = tmp_path / "raster"
+    shutil.copytree(RASTER, folder)
+    return folder / "raster.rig.toml"
+
+
+@contextmanager
+def chain(models=("C-663", "C-663"), faults=(None, None)):
+    """A virtual daisy chain on one pty, its log in memory: yields (server, controllers, log)."""
+    vcs = [VirtualController(model, address, faults=fault or Faults())
+           for address, (model, fault) in enumerate(zip(models, faults))]
+    log = io.StringIO()
+    with PtyServer(Chain(vcs), log) as server:
+        yield server, vcs, log
+
+
+def written(log: io.StringIO | str) -> dict[int, list[str]]:
+    """The MD/RM/RZ lines each address took, in order, from the emulator's log of host bytes."""
+    text = log if isinstance(log, str) else log.getvalue()
+    sent = b"".join(bytes.fromhex(m.group(1)) for m in
+                    re.finditer(r"^\s*[\d.]+ -> ((?:[0-9a-f]{2} ?)+)", text, re.M))
+    by_address, current = {}, None
+    for part in re.split(rb"(\x01.)", sent):
+        if part.startswith(b"\x01") and len(part) == 2:
+            current = int(part[1:].decode(), 16)
+            continue
+        for line in part.split(b"\r"):
+            if re.match(rb"(MD|RM|RZ)", line):
+                by_address.setdefault(current, []).append(line.decode())
+    return by_address
+
+
+def md_counts(server, vcs) -> list[int]:
+    return [server.call(lambda _c, vc=vc: vc.md_count) for vc in vcs]
+
+
+def test_a_full_flash_writes_each_controller_at_its_address_macro_0_last(rig, data_dir):
+    with chain() as (server, vcs, log):
+        result = flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        held = [server.call(lambda _c, vc=vc: dict(vc.macros)) for vc in vcs]
+    assert [p.state for p in result.parts] == [State.FLASHED, State.FLASHED]
+    for part, macros in zip(result.parts, held):
+        wanted = {s: m.line for s, m in part.compiled.program.macros.items()}
+        assert set(macros) == set(wanted)
+    lines = written(log)
+    assert set(lines) == {0, 1}
+    for address in (0, 1):
+        assert lines[address][-1].startswith("MD0,"), lines[address]  # macro 0 last, each
+        assert sum(line.startswith("MD0,") for line in lines[address]) == 1
+
+
+def test_an_unchanged_rig_writes_nothing(rig, data_dir):
+    with chain() as (server, vcs, log):
+        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        before = md_counts(server, vcs)
+        again = flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        assert md_counts(server, vcs) == before
+    assert again.changes_nothing
+    assert [p.state for p in again.parts] == [State.UNCHANGED, State.UNCHANGED]
+
+
+def test_only_flashes_the_named_controllers(rig, data_dir):
+    with chain() as (server, vcs, log):
+        result = flash_rig(server.path, str(rig), only=["y"], timing=FAST_TIMING)
+        counts = md_counts(server, vcs)
+    assert counts[0] == 0 and counts[1] > 0
+    assert [p.state for p in result.parts] == [State.LEFT_OUT, State.FLASHED]
+    assert set(written(log)) == {1}
+
+
+def test_only_with_a_name_the_rig_lacks_is_refused(rig, data_dir):
+    with chain() as (server, vcs, log), pytest.raises(NotChosen, match="z"):
+        flash_rig(server.path, str(rig), only=["z"], timing=FAST_TIMING)
+
+
+def test_a_wrong_model_at_the_second_address_writes_nothing_and_says_so(rig, data_dir):
+    with chain(models=("C-663", "C-863")) as (server, vcs, log), \
+            pytest.raises(Refused) as stopped:
+        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        assert md_counts(server, vcs) == [0, 0]
+    text = stopped.value.message
+    assert "C-863" in text and "y" in text
+    assert "x (address 0): untouched" in text and "y (address 1): untouched" in text
+
+
+def test_a_failure_on_the_second_controller_says_what_each_holds(rig, data_dir):
+    # every MD line for y's slot 1 loses a character: it never verifies
+    with chain(faults=(None, Faults(always_drop_slot=1))) as (server, vcs, log), \
+            pytest.raises(FlashFailed) as stopped:
+        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+    text = stopped.value.message
+    assert "stopped at y (address 1)" in text
+    assert "x (address 0): flashed and verified" in text
+    assert re.search(r"y \(address 1\): partly written; backup of what it held: \S+\.mcm", text)
+
+
+def test_history_records_the_rig_and_each_controller(rig, data_dir):
+    with chain() as (server, vcs, log):
+        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+    found = sorted(history.records(), key=lambda r: r.address)
+    assert [(r.address, r.controller, r.rig_name) for r in found] == [(0, "x", "raster"),
+                                                                       (1, "y", "raster")]
+    assert all(r.rig == str(rig) for r in found)
+
+
+def test_backup_names_a_folder_or_a_prefix(rig, tmp_path, data_dir):
+    with chain() as (server, vcs, log):
+        flash_rig(server.path, str(rig), timing=FAST_TIMING,
+                  options=FlashOptions(backup=f"{tmp_path}/saved/"))
+        flash_rig(server.path, str(rig), timing=FAST_TIMING,
+                  options=FlashOptions(backup=tmp_path / "before.mcm"))
+    assert sorted(p.name for p in (tmp_path / "saved").iterdir()) == ["raster-x.mcm",
+                                                                     "raster-y.mcm"]
+    assert (tmp_path / "before-x.mcm").is_file() and (tmp_path / "before-y.mcm").is_file()
+
+
+# -- the command line ---------------------------------------------------------------------------
+
+def test_cli_flash_rig_prints_one_row_per_controller(rig, data_dir):
+    with chain() as (server, vcs, log):
+        result = cli("flash", server.path, rig, *FAST)
+    assert result.exit_code == 0, result.output
+    rows = [line for line in result.output.splitlines() if re.match(r"[xy]\s+[01]\s+C-663", line)]
+    assert len(rows) == 2 and all("flashed and verified" in row for row in rows)
+
+
+def test_cli_dry_run_shows_the_selection_codes_only_where_the_target_changes(rig, data_dir):
+    with chain() as (server, vcs, log):
+        result = cli("flash", server.path, rig, "--dry-run", *FAST)
+        counts = md_counts(server, vcs)
+    assert result.exit_code == 0, result.output
+    assert counts == [0, 0]
+    sent = [line.split()[1] for line in result.output.splitlines() if line.startswith("  -> ")]
+    selections = [s for s in sent if s.startswith("<01>")]
+    assert selections == ["<01>0", "<01>1"]
+    assert sent[0] == "<01>0"
+
+
+def test_cli_only_and_options_that_do_not_go_with_a_rig(rig, data_dir):
+    assert cli("flash", "/dev/null", rig, "--address", "1").exit_code == 2
+    assert cli("flash", "/dev/null", rig, "--only", "x,,y").exit_code == 2
+    with chain() as (server, vcs, log):
+        result = cli("flash", server.path, rig, "--only", "x", *FAST)
+        assert result.exit_code == 0, result.output
+        assert md_counts(server, vcs)[1] == 0
+    assert "not in --only" in result.output
+
+
+def test_cli_a_failure_exits_1_and_names_each_controller(rig, data_dir):
+    with chain(models=("C-663", "C-863")) as (server, vcs, log):
+        result = cli("flash", server.path, rig, *FAST)
+    assert result.exit_code == 1
+    assert "x (address 0): untouched" in result.output
+    assert "Traceback" not in result.output
+
+
+def test_flash_rig_as_a_process_then_unchanged(rig, tmp_path, data_dir):
+    with chain() as (server, vcs, log):
+        first = mercmac_process("flash", server.path, str(rig), *FAST, cwd=tmp_path)
+        before = md_counts(server, vcs)
+        again = mercmac_process("flash", server.path, str(rig), *FAST, cwd=tmp_path)
+        assert md_counts(server, vcs) == before
+    assert first.returncode == 0, first.stderr
+    assert again.returncode == 0, again.stderr
+    assert "already holds its program" in again.stdout
+
+
+def test_reset_starts_every_macro_0_once_all_are_verified(rig, data_dir):
+    with chain() as (server, vcs, log):
+        flash_rig(server.path, str(rig), timing=FAST_TIMING, options=FlashOptions(reset=True))
+        # the emulator reads the last RT in its own thread
+        assert eventually(server, lambda _c: all(vc.running for vc in vcs))
+    assert log.getvalue().count("52 54 0d") == 2  # 'RT<CR>', once to each (MS176E §6.4 RT)
+
+
+def test_a_rig_with_errors_is_refused_before_the_port_is_touched(rig, data_dir):
+    text = rig.read_text().replace("address = 1 ", "address = 0 ")
+    rig.write_text(text)
+    with chain() as (server, vcs, log):
+        result = cli("flash", server.path, rig, *FAST)
+        counts = md_counts(server, vcs)
+    assert result.exit_code == 1
+    assert counts == [0, 0] and not re.search(r"^\s*[\d.]+ -> ", log.getvalue(), re.M)
+    assert "raster.rig.toml" in result.output and "nothing was flashed" in result.output
+
+
+def test_flash_then_pull_against_emulate_addresses_as_processes(rig, tmp_path, data_dir):
+    log, out = tmp_path / "wire.log", tmp_path / "pulled"
+    with emulating("--addresses", "0,1", "--target", "C-663", "--log", str(log)) as (_, path):
+        flashed = mercmac_process("flash", path, str(rig), *FAST, cwd=tmp_path)
+        pulled = mercmac_process("pull", path, "--rig", str(out), *FAST, cwd=tmp_path)
+    assert flashed.returncode == 0, flashed.stderr
+    assert pulled.returncode == 0, pulled.stderr
+    lines = written(log.read_text())
+    assert [lines[a][-1][:4] for a in (0, 1)] == ["MD0,", "MD0,"]  # macro 0 last on each
+    assert (out / "x.mcm").read_text() == (rig.parent / "x.mcm").read_text()
+    assert (out / "raster.rig.toml").is_file()
