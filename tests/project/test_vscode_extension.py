@@ -64,6 +64,11 @@ def node_packages() -> str:
     lock = hashlib.sha256((VSCODE / "package-lock.json").read_bytes()).hexdigest()
     if not STAMP.exists() or STAMP.read_text() != lock:
         done = _npm("ci", "--no-audit", "--no-fund")
+        if done.returncode != 0 and "ETXTBSY" in done.stderr:
+            # esbuild's install script runs the binary it has just written; while a process
+            # forked at that moment still holds the file open for writing, Linux answers
+            # ETXTBSY ("text file busy"). It is transient: one more `npm ci` installs it.
+            done = _npm("ci", "--no-audit", "--no-fund")
         assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
         STAMP.write_text(lock)
     built = _npm("run", "build", timeout=120)
