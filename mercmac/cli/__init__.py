@@ -197,7 +197,7 @@ def _check_file(path: str, chosen, fixes=None) -> list:
     from mercmac.compiler import checking
     from mercmac.errors import SettingsError
     from mercmac.render.report import printable
-    from mercmac.rig.load import is_rig_path
+    from mercmac.rig import is_rig_path
 
     try:
         if is_rig_path(path):

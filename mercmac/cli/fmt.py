@@ -35,7 +35,7 @@ def _programs(files: tuple[str, ...]) -> tuple[list[str], int]:
     the user wrote: fmt leaves it as written."""
     import os
 
-    from mercmac.rig.load import is_rig_path
+    from mercmac.rig import is_rig_path
 
     rigs = [path for path in files if is_rig_path(path)]
     if not rigs:

@@ -241,7 +241,7 @@ def describe(file, port, address, baud, timeout, fmt, graph) -> None:
 
 
 def _is_rig(path: str) -> bool:
-    from mercmac.rig.load import is_rig_path
+    from mercmac.rig import is_rig_path
 
     return is_rig_path(path)
 

@@ -56,7 +56,7 @@ def run(req: Request) -> bool:
 
 
 def _run(req: Request) -> bool:
-    from mercmac.rig.load import is_rig_path
+    from mercmac.rig import is_rig_path
 
     if is_rig_path(req.file):  # every controller of the rig on one clock (issue 18)
         from mercmac.cli import run_rig

@@ -171,7 +171,7 @@ def only_names(value: str | None) -> list[str] | None:
 
 def _rig_flash_options(file: str, only, *, force: bool, target) -> bool:
     """Whether FILE is a rig; UsageError for options that do not go with it (or without)."""
-    from mercmac.rig.load import is_rig_path
+    from mercmac.rig import is_rig_path
 
     if not is_rig_path(file):
         if only is not None:

@@ -5,3 +5,12 @@
                   --checks--> the rig rules (MRnnn, in mercmac.diagnostics) and each program's
                               findings; compile_rig: each program with its controller's model
 """
+
+SUFFIX = ".rig.toml"
+
+
+def is_rig_path(path: str) -> bool:
+    """True for a file named like a rig (`*.rig.toml`, any case). Here, not in load.py, so
+    that the commands that take a file or a rig (check, sim, fmt, flash) tell them apart
+    without importing the rig reader (`check`'s start-up: benchmarks/check_latency.py)."""
+    return str(path).lower().endswith(SUFFIX)

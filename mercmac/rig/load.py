@@ -13,12 +13,12 @@ from typing import Any, NamedTuple
 
 from mercmac.commands import MODELS
 from mercmac.diagnostics import Report
+from mercmac.rig import SUFFIX, is_rig_path  # noqa: F401 (is_rig_path: read here too)
 from mercmac.rig.locate import Places, locate
 from mercmac.rig.model import Controller, Line, LineKind, Rig, Wire
 from mercmac.source import Source, Span, read_bytes, split_lines, to_lf
 from mercmac.suggest import suggest
 
-SUFFIX = ".rig.toml"
 TOP_KEYS = ("name", "box", "box_buttons", "wires", "joystick", "controllers")
 CONTROLLER_KEYS = ("address", "model", "program")
 BRANCHES = ("X", "Y", "Z")  # C-819.20 (X, Y through the Y-cable) and C-819.30 (X, Y, Z), §3.6
@@ -36,11 +36,6 @@ class RigFile(NamedTuple):
     rig: Rig | None
     report: Report
     places: Places
-
-
-def is_rig_path(path: str) -> bool:
-    """True for a file named like a rig (`*.rig.toml`, any case)."""
-    return str(path).lower().endswith(SUFFIX)
 
 
 def read_rig(path: str) -> RigFile:
