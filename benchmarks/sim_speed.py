@@ -20,12 +20,21 @@ fix) and prints the wall time scaled to a simulated day.
 Loops whose passes differ by a constant shift of position and target (issue 11,
 item 3), 1500 simulated days each (goal: under 2 s of wall time each):
 (f) `every 10ms { MR 1, WS 0 }`: a scan stepping forever (into the soft limit);
-(g) Example 4 in mode 1 with button 1 held from power-on (`--buttons 1@0`).
+(g) Example 4 in mode 1 with button 1 held from power-on (`--buttons 1@0`);
+(g') `every 10ms { MR 1, WS 0, TS }` from -3000, across the reference edge (issue 19).
+
+Loops that report or move while the stage moves (issue 19), 1500 simulated days each on
+the C-863 and the C-663 (goal: at most 2 s of wall time each); each is first run for ten
+simulated minutes (the issue's table), and the 1500-day run is given up after MOVING_GIVE_UP
+seconds (printed as "over"), so that a loop that is not skipped does not run for days:
+(i) `macro m { TT, MR 1, when 4 { goto fin }, goto m }`: reports between short moves;
+(j) `every 30ms { TT, MR 1, TT, MR 2, ... TT, MR 9 }`: a long body that reports.
 
 A rig (issue 18 §3, goal: at most 2 s of wall time):
 (h) the raster example (examples/rigs/raster/), one simulated hour from button 1 on X:
     both controllers on one clock, joint fast-forward on; then in-process, the same hour
-    stepped (joint fast-forward off) for the ratio.
+    stepped (joint fast-forward off) for the ratio; and the same to 1500 simulated days
+    (issue 19; not stepped).
 """
 from __future__ import annotations
 
@@ -58,15 +67,30 @@ CASES = {
 LOOP = "[MC00] CN1,WA20,RP,RP\n"
 LONG_MS = 1500 * 24 * 3_600_000
 JOG = "autostart {\n  every 10ms { MR 1, WS 0 }\n}\n"
+TS_JOG = "autostart {\n  MA -3000, WS 0\n  every 10ms { MR 1, WS 0, TS }\n}\n"
 SHIFT_CASES = {
     "every 10ms { MR 1, WS 0 } to 1500d": lambda: measure_source(JOG, LONG_MS),
+    "every 10ms { MR 1, WS 0, TS } across the reference, 1500d":
+        lambda: measure_source(TS_JOG, LONG_MS),
     "example 4, mode 1, button 1 held, 1500d": lambda: measure(
         [EXAMPLE4, "--buttons", "1@0", "--until", "1500d"]),
+}
+MOVING_GIVE_UP = 60  # s of wall time for one 1500-day run of a loop that is not skipped
+TEN_MINUTES_MS = 600_000
+MOVING_CASES = {
+    "macro m { TT, MR 1, when 4 { goto fin }, goto m }":
+        "macro m {\n  TT, MR 1, when 4 { goto fin }, goto m\n}\nmacro fin {\n  TP\n}\n"
+        "autostart { goto m }\n",
+    "every 30ms { TT, MR 1, ... TT, MR 9 }":
+        "autostart {\n  every 30ms { "
+        + ", ".join(f"TT, MR {n}" for n in range(1, 10)) + " }\n}\n",
 }
 RASTER = os.path.join(HERE, "..", "examples", "rigs", "raster", "raster.rig.toml")
 RIG_CASES = {
     "raster rig, 1 h from button 1 on x": (
         [os.path.abspath(RASTER), "--buttons", "x:1@0-100ms", "--until", "1h"], HOUR_MS),
+    "raster rig, 1500 d from button 1 on x": (
+        [os.path.abspath(RASTER), "--buttons", "x:1@0-100ms", "--until", "1500d"], LONG_MS),
 }
 # (source, simulated ms, simulated ms with --short)
 DAY_CASES = {
@@ -78,7 +102,7 @@ DAY_CASES = {
 }
 
 
-def measure(args: list[str]) -> tuple[float, dict]:
+def measure(args: list[str], timeout: float | None = None) -> tuple[float, dict]:
     """Run `mercmac sim ... --format json` in a fresh interpreter; wall seconds and result."""
     import json
 
@@ -90,11 +114,13 @@ def measure(args: list[str]) -> tuple[float, dict]:
     start = time.perf_counter()
     done = subprocess.run([sys.executable, "-m", "mercmac", "sim", *args, "--format", "json"],
                           input=LOOP if args[0] == "-" else None, capture_output=True,
-                          text=True, check=True, cwd=tempfile.gettempdir(), env=env)
+                          text=True, check=True, cwd=tempfile.gettempdir(), env=env,
+                          timeout=timeout)
     return time.perf_counter() - start, json.loads(done.stdout)
 
 
-def measure_source(source: str, until_ms: int) -> tuple[float, dict]:
+def measure_source(source: str, until_ms: int, *options: str,
+                   timeout: float | None = None) -> tuple[float, dict]:
     """Simulate a high-level source for until_ms in a fresh interpreter; wall s and JSON."""
     import tempfile
 
@@ -102,7 +128,22 @@ def measure_source(source: str, until_ms: int) -> tuple[float, dict]:
         path = os.path.join(folder, "case.mcm")
         with open(path, "w", encoding="utf-8") as f:
             f.write(source)
-        return measure([path, "--until", f"{until_ms}ms"])
+        return measure([path, "--until", f"{until_ms}ms", *options], timeout)
+
+
+def moving_case(name: str, source: str, target: str) -> None:
+    """Ten minutes, then 1500 days (given up after MOVING_GIVE_UP s) of one moving loop."""
+    wall, result = measure_source(source, TEN_MINUTES_MS, "--target", target)
+    line = (f"{name} on the {target.upper()}: 10 min in {wall:.2f} s wall "
+            f"(position {result['final']['position']:,}); 1500d in ")
+    try:
+        wall, result = measure_source(source, LONG_MS, "--target", target,
+                                      timeout=MOVING_GIVE_UP)
+    except subprocess.TimeoutExpired:
+        print(line + f"over {MOVING_GIVE_UP} s wall")
+        return
+    print(line + f"{wall:.2f} s wall -> ratio {LONG_MS / 1000 / wall:,.0f} : 1 "
+          f"(position {result['final']['position']:,})")
 
 
 def presses_at_one_instant(count: int) -> float:
@@ -152,13 +193,18 @@ def main() -> None:
         final = result["final"]
         print(f"{name}: simulated {LONG_MS / 1000:,.0f} s in {wall:.2f} s wall "
               f"-> ratio {LONG_MS / 1000 / wall:,.0f} : 1 (position {final['position']:,})")
+    for name, source in MOVING_CASES.items():
+        for target in ("c-863", "c-663"):
+            moving_case(name, source, target)
     for name, (args, simulated_ms) in RIG_CASES.items():
         wall, result = measure(args)
         y = result["controllers"]["y"]["final"]
-        stepped = raster_stepped(simulated_ms)
+        # stepping 1500 days would take days: only the hour is stepped for the ratio
+        stepped = (f"; stepped in-process: {raster_stepped(simulated_ms):.2f} s"
+                   if simulated_ms <= HOUR_MS else "")
         print(f"{name}: simulated {simulated_ms / 1000:,.0f} s in {wall:.2f} s wall "
-              f"-> ratio {simulated_ms / 1000 / wall:,.0f} : 1 (y at {y['position']:,}; "
-              f"stepped in-process: {stepped:.2f} s)")
+              f"-> ratio {simulated_ms / 1000 / wall:,.0f} : 1 (y at {y['position']:,}"
+              f"{stepped})")
     for name, (args, simulated_ms) in CASES.items():
         wall, result = measure(args)
         simulated = simulated_ms if simulated_ms is not None else result["ended_ms"]

@@ -81,6 +81,9 @@ class Trace:
     outputs: dict = field(default_factory=dict)  # output 1-4 -> [(t_on, t_off)]
     macros: list = field(default_factory=list)  # (t0, t1, label)
     skips: list = field(default_factory=list)  # (t, t_to, passes, loop label)
+    # long skips that move: (t, t_to, (low, high) at t, (low, high) at t_to), the band the
+    # position sweeps (its min and max in every pixel column, one pass wide)
+    envelopes: list = field(default_factory=list)
     actions: list = field(default_factory=list)  # times of input changes, moves, hazards
     hazards: list = field(default_factory=list)  # (t, rule)
     end: int = 0
@@ -168,6 +171,7 @@ class PlotObserver:
         self._follow(skip.t)
         span, moved = skip.t_to - skip.t, skip.passes * skip.shift
         if not self._copied(skip):
+            self._envelope(skip)
             self.trace.position += [(skip.t, float(skip.position)),
                                     (skip.t_to, float(skip.position + moved))]
             self.trace.target.append((skip.t_to, self.trace.target[-1][1] + moved))
@@ -189,6 +193,17 @@ class PlotObserver:
             into += [(t + k * skip.period, x + k * skip.shift)
                      for k in range(1, skip.passes + 1) for t, x in pass_]
         return True
+
+    def _envelope(self, skip: ev.FastForwarded) -> None:
+        """The band a long skip's passes sweep: the pass before it spans low..high about its
+        start, and each pass starts `shift` further, so in a pixel column of many passes the
+        position's min and max lie on two straight lines (the passes are copies)."""
+        start = skip.position - skip.shift  # where the pass before began
+        seen = [x for _, x in _since(self.trace.position, skip.t - skip.period, skip.t)]
+        low, high = min(seen, default=start) - start, max(seen, default=start) - start
+        last = skip.position + (skip.passes - 1) * skip.shift
+        self.trace.envelopes.append((skip.t, skip.t_to, (skip.position + low, skip.position + high),
+                                     (last + low, last + high)))
 
     def _follow(self, t: float) -> None:
         """Position samples of the running profile up to t: CURVE points along each
@@ -414,6 +429,9 @@ def position(ax, trace: Trace, axis: TimeAxis) -> None:
     """Position and target over time; far targets as arrows on the edge, hazards marked."""
     t, x = zip(*trace.position)
     ax.plot(axis(t), x, color="tab:blue", lw=1.6, label="position")
+    for t0, t1, at0, at1 in trace.envelopes:  # above the hatching (zorder 3) of its band
+        ax.fill_between(axis([t0, t1]), [at0[0], at1[0]], [at0[1], at1[1]], color="tab:blue",
+                        alpha=0.45, lw=0.8, edgecolor="tab:blue", zorder=4)
     t, x = zip(*trace.target)
     ax.step(axis(t), x, where="post", color="tab:red", lw=1, ls="--", label="target")
     low, high = _y_range(trace)
@@ -447,7 +465,8 @@ def _cut(ax, x: float, total: float) -> None:
 
 def _y_range(trace: Trace) -> tuple[float, float]:
     """The position axis: where the stage goes, with the targets near it; a margin of 5%."""
-    xs = [x for _, x in trace.position]
+    xs = [x for _, x in trace.position] + [x for *_, at0, at1 in trace.envelopes
+                                            for x in (*at0, *at1)]
     low, high = min(xs), max(xs)
     reach = max(high - low, 10)  # a target further out than the travel itself is clipped
     near = [x for _, x in trace.target if low - reach <= x <= high + reach]

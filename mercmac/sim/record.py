@@ -14,9 +14,10 @@ lines it leaves out at each verbosity.
 """
 from __future__ import annotations
 
-from collections import Counter
-from dataclasses import dataclass
+from collections import Counter, deque
+from dataclasses import dataclass, replace
 from itertools import islice
+from typing import Iterator
 
 from mercmac.ops import TextEnum
 from mercmac.vm import events as ev
@@ -25,6 +26,7 @@ from mercmac.vm.opcodes import Opcode
 
 CAP = 10_000  # SPEC §5: reports, output changes and events beyond this are counted, not listed
 TIMELINE_CAP = 100_000  # timeline entries listed; the rest are counted (Recorder.unlisted)
+RECENT = 100_000  # events remembered to copy a skipped pass's (a longer pass is only counted)
 LONG_LOOP = 1000  # an RP repeating this often or more makes a macro a mode, not a step
 
 
@@ -54,6 +56,54 @@ class Folded:
     first_t: int = 0
 
 
+@dataclass(slots=True, frozen=True)
+class Block:
+    """A skip as the events list sees it: `passes` copies of `template` (the events of the
+    stepped pass before it, inner skips as Blocks), each `period` us and `shift` counts on."""
+
+    t: int
+    period: int
+    passes: int
+    shift: int
+    template: tuple
+    size: int  # events in one pass
+
+
+def _size(entry) -> int:
+    return entry.size * entry.passes if isinstance(entry, Block) else 1
+
+
+def _moved(event, dt: int, dx: int, texts):
+    """An event of a stepped pass as the pass `dt` us and `dx` counts later makes it; a
+    report's text comes from the skip's own reports (fastforward.expand) when it shifts."""
+    match event:
+        case ev.Reported() if texts is not None:
+            shifted = next(texts, None)  # None only were pass and shape to disagree
+            return replace(event, t=event.t + dt,
+                           text=event.text if shifted is None else shifted.text)
+        case ev.MoveStarted():
+            return replace(event, t=event.t + dt, target=event.target + dx,
+                           arrival=event.arrival + dt)
+        case ev.MoveEnded() | ev.HomeDefined():
+            return replace(event, t=event.t + dt, position=event.position + dx)
+    return replace(event, t=event.t + dt)
+
+
+def unroll(template: tuple, passes: int, period: int, shift: int, dt: int, dx: int,
+           texts) -> Iterator:
+    """The events of `passes` copies of a stepped pass, inner skips unrolled alike."""
+    for k in range(1, passes + 1):
+        at, by = dt + k * period, dx + k * shift
+        for entry in template:
+            if isinstance(entry, Block):
+                if not entry.size:  # passes that did nothing: a million of them list nothing
+                    continue
+                yield from unroll(entry.template, entry.passes, entry.period, entry.shift,
+                                  at, by, texts)
+            else:
+                yield _moved(entry, at, by, texts)
+
+
 def modes(chunks: dict) -> tuple[set[tuple[int, int]], set[int]]:
     """The (caller, callee) pairs only ever reached by a tail EM, and the long-loop slots."""
     tail, inner, loops = set(), set(), set()
@@ -76,6 +126,8 @@ class Recorder:
         self.timeline: list = []
         self.trace: list[ev.Executed] = []
         self.events: list = []  # every event but Executed, unfolded, for JSON (SPEC §5 `events`)
+        # the latest events (skips as Blocks): a skip's passes copy the stepped one before it
+        self._recent: deque = deque(maxlen=RECENT)
         self.dropped = {"reports": 0, "outputs": 0, "timeline": 0, "trace": 0, "events": 0}
         # past TIMELINE_CAP: folds by kind, other events (one line at every verbosity) and
         # stretches between two events with polls (one line at `-v`)
@@ -98,6 +150,8 @@ class Recorder:
             self._keep(self.trace, event, "trace")
             return
         self._keep(self.events, event, "events")
+        if not isinstance(event, ev.FastForwarded):
+            self._recent.append(event)
         if isinstance(event, (ev.MacroEntered, ev.MacroLeft)):
             self._flow(event)
             return
@@ -109,7 +163,7 @@ class Recorder:
             self.hazards.append(event)
         elif isinstance(event, ev.ProgramEnded):
             self.ended_at = event.t
-        elif isinstance(event, ev.FastForwarded) and event.shape:
+        elif isinstance(event, ev.FastForwarded):
             self._skipped(event)
         self._folds.clear()
         self._entered = None
@@ -117,7 +171,7 @@ class Recorder:
         self._log(event)
 
     def _skipped(self, skip: ev.FastForwarded) -> None:
-        """The reports and output changes of skipped passes: listed up to the cap, counted."""
+        """What skipped passes emitted: listed up to the cap, counted."""
         for kind, into, what in ((ff.REPORT, self.reports, "reports"),
                                  (ff.OUTPUTS, self.outputs, "outputs")):
             total = ff.count(skip.shape, kind) * skip.passes
@@ -128,6 +182,47 @@ class Recorder:
                                             skip.position, skip.shift),
                                    room))
                 self.dropped[what] += total - (len(into) - listed)
+        self._skipped_events(skip)
+
+    def _skipped_events(self, skip: ev.FastForwarded) -> None:
+        """The moves, arrivals, reports and macro entries of skipped passes: copies of the
+        stepped pass before the skip, listed up to the cap and counted (SPEC §5 `events`)."""
+        template = self._pass_before(skip.t, skip.period)
+        if template is None:  # longer than RECENT events: the skip stays a marker only
+            return
+        block = Block(skip.t, skip.period, skip.passes, skip.shift, template,
+                      sum(_size(entry) for entry in template))
+        self._recent.append(block)
+        if not block.size:
+            return
+        texts = None
+        if skip.shift or not ff.plain(skip.shape):  # positions in reports move on
+            texts = ff.expand(skip.shape, skip.t, skip.period, skip.passes, ff.REPORT,
+                              skip.position, skip.shift)
+        listed = len(self.events)
+        self.events.extend(islice(unroll(template, skip.passes, skip.period, skip.shift,
+                                         0, 0, texts), max(CAP - listed, 0)))
+        self.dropped["events"] += _size(block) - (len(self.events) - listed)
+
+    def _pass_before(self, t: int, period: int) -> tuple | None:
+        """The events of the stepped pass that ends at t, as plain stepping repeats them: those
+        after t - period up to t, and those at t - period past the ones the pass ends with
+        (at t, before the loop's anchor)."""
+        start, inside, at_start = t - period, [], []
+        recent = self._recent
+        i = len(recent) - 1
+        while i >= 0 and recent[i].t > start:
+            inside.append(recent[i])
+            i -= 1
+        while i >= 0 and recent[i].t == start:
+            at_start.append(recent[i])
+            i -= 1
+        if i < 0 and len(recent) == recent.maxlen:
+            return None
+        ending = sum(1 for entry in inside if entry.t == t)
+        at_start.reverse()
+        inside.reverse()
+        return tuple(at_start[ending:] + inside)
 
     def _keep(self, into: list, event, what: str) -> None:
         if len(into) < (CAP if what in ("reports", "outputs", "events") else TIMELINE_CAP):

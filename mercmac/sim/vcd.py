@@ -9,6 +9,7 @@ The dump stops cleanly before it would pass `limit` bytes; `cut_at` says when.
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import IO
 
 from vcd import VCDWriter
@@ -17,6 +18,7 @@ from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
 
 SAMPLE_US = 1000  # position samples while moving
+MOVES_KEPT = 64  # moves remembered for the last pass of a shifted skip (a longer pass: some)
 CLOSING = 65_536  # bytes kept in hand below the limit: far more than one event writes
 
 
@@ -57,6 +59,7 @@ class VcdObserver:
         self.segments: tuple = ()
         self.sampled_to = 0
         self.last = 0
+        self.moves: list = []  # the latest moves: a shifted skip's last pass copies them
 
     def on_event(self, event) -> None:
         if self.cut_at is None:
@@ -90,28 +93,52 @@ class VcdObserver:
             case ev.MoveStarted(_, _, target, _, segments):
                 w.change(self.target, t, target)
                 self.segments, self.sampled_to = segments, t
+                self.moves = self.moves[-MOVES_KEPT + 1:] + [event]
             case ev.MoveEnded(_, _, position) | ev.HomeDefined(_, position):
                 self.segments = ()
                 w.change(self.position, t, position)
-            case ev.FastForwarded(_, _, passes, period, _, shape):
-                self._stretch(t, passes, period, shape)
+            case ev.FastForwarded():
+                self._stretch(event)
 
     def _outputs(self, t: int, pattern: int) -> None:
         for i, var in enumerate(self.outputs):
             self.writer.change(var, t, pattern >> i & 1)
 
-    def _stretch(self, t: int, passes: int, period: int, shape: tuple) -> None:
-        """Skipped passes: marked, all but the last left out; the last one dumped."""
-        for step in ff.compact(shape, t, period, passes):
+    def _stretch(self, skip: ev.FastForwarded) -> None:
+        """Skipped passes: marked, all but the last left out; the last one dumped (of a
+        shifted skip with the position: vcd changes must come in time order)."""
+        changes = []
+        for step in ff.compact(skip.shape, skip.t, skip.period, skip.passes):
             match step:
                 case ff.Stretch(start, last, n):
                     if n > 1:
-                        self.writer.change(self.skipping, start, 1)
-                        self.writer.change(self.skipping, last, 0)
-                    self.last = last
+                        changes += [(start, self.skipping, 1), (last, self.skipping, 0)]
                 case ev.OutputsChanged(at, pattern):
-                    self.last = at
-                    self._outputs(at, pattern)
+                    changes += [(at, var, pattern >> i & 1)
+                                for i, var in enumerate(self.outputs)]
+        if skip.shift or not ff.plain(skip.shape):
+            changes += self._last_pass(skip)
+        for t, var, value in sorted(changes, key=lambda change: change[0]):
+            self.writer.change(var, t, value)
+            self.last = max(self.last, t)
+
+    def _last_pass(self, skip: ev.FastForwarded) -> list:
+        """The position in a shifted skip: where its passes start and, sampled, the moves of
+        its last pass (copies of the stepped pass before the skip, `shift` further on)."""
+        last = skip.t + (skip.passes - 1) * skip.period
+        at_last = skip.position + (skip.passes - 1) * skip.shift
+        changes = [(skip.t, self.position, skip.position), (last, self.position, at_last)]
+        dt, dx = (skip.passes - 1) * skip.period, (skip.passes - 1) * skip.shift
+        for move in [m for m in self.moves if skip.t - skip.period <= m.t < skip.t]:
+            changes.append((move.t + skip.period + dt, self.target, move.target + skip.shift + dx))
+            segments = tuple(replace(seg, t0=seg.t0 + skip.period + dt,
+                                     x0=seg.x0 + skip.shift + dx) for seg in move.segments)
+            if segments:
+                end = min(int(segments[-1].t1), skip.t_to - 1)
+                changes += [(t, self.position, round(_position(segments, t)))
+                            for t in range(int(segments[0].t0), end, SAMPLE_US)]
+                changes.append((end, self.position, round(_position(segments, end))))
+        return changes
 
     def _sample(self, until: int) -> None:
         """Position samples of the running profile up to `until`."""

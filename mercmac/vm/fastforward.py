@@ -25,9 +25,11 @@ start position) and the same delta are copies; the skip (`shifted_passes`)
 stops before the next boundary: a soft limit or +-MAX_POSITION clamp, a hard
 limit switch, the end of the run, an input change, the RP counter's end, and the
 time from which the float sum of a profile's segment lengths could round to
-another arrival microsecond. What a pass does that cannot shift exactly (a
-report or a command while the axis moves, a trigger, a reference search, DH, a
-limit hit) leaves `Note.UNSHIFTABLE` in the effect log and makes the pass unskippable.
+another arrival microsecond; and for a pass that reads TS (issue 19), the edges
+of the reference and limit switches, whose lines its text shows (`_one_side`).
+What a pass does that cannot shift exactly (a report or a command while the axis
+moves, a trigger, a reference search, DH, a limit hit) leaves `Note.UNSHIFTABLE`
+in the effect log and makes the pass unskippable.
 """
 from __future__ import annotations
 
@@ -387,15 +389,20 @@ def same_shifted_pass(previous: Visit, now: Visit) -> bool:
             and now.delta == previous.delta and now.moved == previous.moved)
 
 
-def shifted_passes(now: Visit, period: int, fit: int, bounds: tuple, hard: tuple | None) -> int:
+def shifted_passes(now: Visit, period: int, fit: int, bounds: tuple, hard: tuple | None,
+                   reference: float | None = None) -> int:
     """How many of `fit` passes shifted by now.delta each stay clear of every boundary.
 
     bounds: the soft range (max(JL, -MAX_POSITION), min(JH, MAX_POSITION)) at the anchor;
-    hard: the limit switches in present coordinates, or None.
+    hard: the limit switches in present coordinates, or None; reference: the reference
+    switch's edge in present coordinates, or None to skip no pass that shows the switches.
     """
     delta, pos = now.delta, now.position
     if delta and _shows_switches(now.moved):
-        return 0  # TS shows the switches: where they are crossed is not counted here
+        if reference is None:
+            return 0  # TS shows the switches: where they are crossed is not counted here
+        for edge in (reference, *(hard or ())):  # the reference and limit lines (§6.4 TS)
+            fit = min(fit, _one_side(now, edge, fit))
     for move, latest, starts in _moves(now.moved, 0, (0,)):
         for start in starts:
             fit = min(fit, _unclamped(move, pos + start, delta, fit),
@@ -412,6 +419,30 @@ def _shows_switches(shape: tuple) -> bool:
             case Shifted(shape=inner) if _shows_switches(inner):
                 return True
     return False
+
+
+FAR = 2**64  # beyond any position (a finite bound: _last_inside divides by the shift)
+
+
+def _one_side(now: Visit, edge: float, fit: int) -> int:
+    """Passes that stay, with the pass just seen, on one side of a switch's edge: TS at rest
+    shows the reference line (§6.4 FE2) and the limit lines, so its text repeats until a
+    pass's span reaches an edge."""
+    low = high = 0  # the span of positions a pass visits, relative to its start
+    for move, _, starts in _moves(now.moved, 0, (0,)):
+        for start in starts:
+            low = min(low, start + move.target, start + move.origin)
+            high = max(high, start + move.target, start + move.origin)
+    first = now.position - now.delta  # the pass just seen, whose TS texts the skip repeats
+    # a count clear of the edge: Axis.reference_high and limit_switch compare position - DH
+    # shift in floats
+    if first + high <= edge - 1:
+        lo, hi = -FAR, math.floor(edge - 1) - high
+    elif first + low >= edge + 1:
+        lo, hi = math.ceil(edge + 1) - low, FAR
+    else:
+        return 0
+    return max(_last_inside(lo, hi, first, now.delta, fit + 1) - 1, 0)
 
 
 def _moves(shape: tuple, latest: int, starts: tuple) -> Iterator[tuple[Move, int, tuple]]:

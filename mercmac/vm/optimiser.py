@@ -177,7 +177,8 @@ class Optimiser:
         period = visit.wake - previous.wake
         fit = ff.skippable(previous, visit, self._bound(), remaining)
         axis = self.machine.axis
-        passes = ff.shifted_passes(visit, period, fit, axis.soft_range(), axis.switches())
+        passes = ff.shifted_passes(visit, period, fit, axis.soft_range(), axis.switches(),
+                                   axis.options.reference_at + axis.shift)
         if passes < fit:  # a boundary, not the counter, ends it: enclosing passes differ
             self.log.append(Note.UNSHIFTABLE)
         if passes > 0:
