@@ -7,6 +7,7 @@ from itertools import islice
 from typing import IO, Iterator
 
 from mercmac.mdtext import slot_name
+from mercmac.render import jsontext
 from mercmac.render.console import Line, write_lines
 from mercmac.timespec import format_clock, format_span
 from mercmac.vm import events as ev
@@ -308,7 +309,7 @@ def write_scenario_passed(path: str, checked: int, stream: IO[str] | None = None
 
 def to_json(run: Run) -> str:
     """SPEC §5 `sim --format json`."""
-    return json.dumps(run_json(run), indent=2)
+    return jsontext.dumps(run_json(run))  # json.dumps(..., indent=2), faster
 
 
 def run_json(run: Run) -> dict:

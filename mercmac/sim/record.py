@@ -15,7 +15,9 @@ lines it leaves out at each verbosity.
 from __future__ import annotations
 
 from collections import Counter, deque
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields
+from functools import lru_cache
+from operator import attrgetter
 from itertools import islice
 from typing import Iterator
 
@@ -23,10 +25,12 @@ from mercmac.ops import TextEnum
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
 from mercmac.vm.opcodes import Opcode
+from mercmac.vm.trapezoid import Segment
 
 CAP = 10_000  # SPEC §5: reports, output changes and events beyond this are counted, not listed
 TIMELINE_CAP = 100_000  # timeline entries listed; the rest are counted (Recorder.unlisted)
 RECENT = 100_000  # events remembered to copy a skipped pass's (a longer pass is only counted)
+_MOVE_FIELDS = attrgetter(*(f.name for f in fields(ev.MoveStarted)))
 LONG_LOOP = 1000  # an RP repeating this often or more makes a macro a mode, not a step
 
 
@@ -75,18 +79,31 @@ def _size(entry) -> int:
 
 def _moved(event, dt: int, dx: int, texts):
     """An event of a stepped pass as the pass `dt` us and `dx` counts later makes it; a
-    report's text comes from the skip's own reports (fastforward.expand) when it shifts."""
-    match event:
-        case ev.Reported() if texts is not None:
-            shifted = next(texts, None)  # None only were pass and shape to disagree
-            return replace(event, t=event.t + dt,
-                           text=event.text if shifted is None else shifted.text)
-        case ev.MoveStarted():
-            return replace(event, t=event.t + dt, target=event.target + dx,
-                           arrival=event.arrival + dt)
-        case ev.MoveEnded() | ev.HomeDefined():
-            return replace(event, t=event.t + dt, position=event.position + dx)
-    return replace(event, t=event.t + dt)
+    report's text comes from the skip's own reports (fastforward.expand) when it shifts.
+    (Built by the constructors: dataclasses.replace is four times slower, and a skip may list
+    10,000 of them.)"""
+    cls = type(event)
+    if cls is ev.MoveStarted:
+        t, kind, target, arrival, segments, where = _MOVE_FIELDS(event)
+        return cls(t + dt, kind, target + dx, arrival + dt,
+                   tuple([Segment(s.t0 + dt, s.x0 + dx, s.v0, s.a, s.dt) for s in segments]),
+                   where)
+    if cls is ev.MoveEnded:
+        return cls(event.t + dt, event.how, event.position + dx)
+    if cls is ev.HomeDefined:
+        return cls(event.t + dt, event.position + dx, event.where)
+    if cls is ev.Reported and texts is not None:
+        shifted = next(texts, None)  # None only were pass and shape to disagree
+        return cls(event.t + dt, event.text if shifted is None else shifted.text, event.where)
+    return cls(event.t + dt, *_rest(cls)(event))
+
+
+@lru_cache(maxsize=None)
+def _rest(cls: type):
+    """The fields of an event class after its time, read at once."""
+    names = [f.name for f in fields(cls)][1:]
+    getter = attrgetter(*names) if names else (lambda event: ())
+    return (lambda event: (getter(event),)) if len(names) == 1 else getter
 
 
 def unroll(template: tuple, passes: int, period: int, shift: int, dt: int, dx: int,
@@ -187,10 +204,11 @@ class Recorder:
     def _skipped_events(self, skip: ev.FastForwarded) -> None:
         """The moves, arrivals, reports and macro entries of skipped passes: copies of the
         stepped pass before the skip, listed up to the cap and counted (SPEC §5 `events`)."""
-        template = self._pass_before(skip.t, skip.period)
+        end = skip.t if skip.anchor_t is None else skip.anchor_t
+        template = self._pass_before(end, skip.period)
         if template is None:  # longer than RECENT events: the skip stays a marker only
             return
-        block = Block(skip.t, skip.period, skip.passes, skip.shift, template,
+        block = Block(end, skip.period, skip.passes, skip.shift, template,
                       sum(_size(entry) for entry in template))
         self._recent.append(block)
         if not block.size:

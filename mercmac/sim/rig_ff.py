@@ -32,7 +32,6 @@ if TYPE_CHECKING:
     from mercmac.sim.rig import RigSim
 
 INF = math.inf
-EXACT_US = 2 ** 53  # below this, sums of whole floats are exact (_whole)
 SEEN_LIMIT = 4096  # joint keys remembered; a rig whose state never repeats forgets them
 _BLOCK = Machine.STATE_KEY.index("block")
 _COUNTERS = Machine.STATE_KEY.index("counters")
@@ -136,9 +135,9 @@ class JointForward:
             shape = visit.shapes[i]
             if not ff.plain(shape):
                 now = ff.Visit(None, visit.t, 0, 0, 0, None, (), visit.positions[i],
-                               visit.deltas[i], _whole(shape))
+                               visit.deltas[i], shape)
                 fit = ff.shifted_passes(now, period, fit, m.axis.soft_range(), m.axis.switches())
-        return min(fit, max((EXACT_US - visit.t) // period - 1, 0))
+        return fit
 
     # ------------------------------------------------------------ the skip
     def _jump(self, key: tuple, previous: JointVisit, visit: JointVisit, period: int,
@@ -173,19 +172,6 @@ class JointForward:
             if len(sim.edges) >= CAP:
                 sim.edges_dropped += count * (passes - p)
                 return
-
-
-def _whole(shape: tuple) -> tuple:
-    """The shape with the arrival check of every move whose segments last whole
-    microseconds taken off: each starts at a whole us (a command's time), so every float sum
-    of its segments is exact below EXACT_US and it arrives at the same offset in any pass
-    (fastforward._same_arrival, which must assume any float, would stop the skip at once)."""
-    return tuple(item._replace(dts=()) if _whole_move(item) else item for item in shape)
-
-
-def _whole_move(item: tuple) -> bool:
-    return (type(item) is ff.Move and item.arrival == sum(item.dts)
-            and all(float(d).is_integer() for d in item.dts))
 
 
 def _machine_key(m: Machine, t: int) -> tuple | None:

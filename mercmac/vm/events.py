@@ -156,6 +156,9 @@ class FastForwarded:
     shape: tuple = ()
     position: int = 0  # a shifted skip (fastforward.moved_shape): the first pass's start position
     shift: int = 0  # and how much further each next pass starts; 0: passes identical
+    # when the loop came round: the skipped passes end there, k periods on (t, the next
+    # command, may be a cycle later, and an arrival fall between); None: at t
+    anchor_t: int | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -57,6 +57,7 @@ class Tag(Enum):
     MOVE = "move"
     ARRIVE = "arrive"
     ABSOLUTE = "absolute"  # a TS report: it shows the switches, not a relative position
+    FLOATS = "floats"  # the pass computes with fractional positions (_same_binade)
 
 
 REPORT, OUTPUTS = Tag.REPORT, Tag.OUTPUTS  # what count and expand select
@@ -117,7 +118,7 @@ class Placed(NamedTuple):
 
 
 class Absolute(NamedTuple):
-    tag: Tag  # Tag.ABSOLUTE
+    tag: Tag  # Tag.ABSOLUTE or Tag.FLOATS
 
 
 class Requested(NamedTuple):
@@ -129,8 +130,9 @@ class Requested(NamedTuple):
 
 
 class Move(NamedTuple):
-    """A profile started from rest: to `target` from `origin` (both relative to the pass's
-    start position), lasting `arrival` us in segments of `dts` us."""
+    """A profile: to `target` from `origin` (relative to the pass's start position; origin a
+    float when it starts on the way), lasting `arrival` us in segments of `dts` us, through
+    positions from `low` to `high` (a profile that turns round overshoots both)."""
 
     tag: Tag  # Tag.MOVE
     offset: int
@@ -140,6 +142,8 @@ class Move(NamedTuple):
     requested: Requested | None  # relative to the pass's start; None for a stop
     arrival: float
     dts: tuple[float, ...]
+    low: float
+    high: float
     __match_args__ = ("offset", "kind", "target", "origin", "requested", "arrival", "dts")
 
 
@@ -151,6 +155,7 @@ class Arrive(NamedTuple):
 
 
 ABSOLUTE = Absolute(Tag.ABSOLUTE)
+FLOATING = Absolute(Tag.FLOATS)
 
 
 class Shows(NamedTuple):
@@ -164,6 +169,7 @@ class Note(Enum):
     """A note in the effect log about the pass it is in; never emitted."""
 
     SWITCHES = "switches"  # the report just logged (TS) shows the switches
+    FLOATS = "floats"  # a profile or a report of the pass took a fractional position
     UNSHIFTABLE = "unshiftable"  # the pass did something a shifted pass cannot repeat
 
 
@@ -237,6 +243,9 @@ def moved_shape(events: list, start: int, position: int) -> tuple | None:
                 items.append(Arrive(Tag.ARRIVE, t - start, at - position))
             case Note.SWITCHES:  # compared by value: after the events (their __eq__ is slow)
                 items.append(ABSOLUTE)
+            case Note.FLOATS:
+                if FLOATING not in items:
+                    items.append(FLOATING)
             case _:  # a reference search, joystick, limit hit, DH, hazard, input, UNSHIFTABLE
                 return None
     return tuple(items)
@@ -247,11 +256,21 @@ def _skip(e: ev.FastForwarded, start: int) -> Skip:
 
 
 def _move(e: ev.MoveStarted, start: int, position: int, requested: Requested | None) -> Move:
-    """A profile from rest (else the pass is unshiftable): it runs from segs[0].x0 to the
-    target, one way."""
-    origin = round(e.segments[0].x0) - position if e.segments else e.target - position
+    """A profile from segs[0].x0 to the target, relative to the pass's start position (from
+    rest on a count, a whole count; else a float, the same within one power of two)."""
+    segments = e.segments
+    if not segments:
+        here = e.target - position
+        return Move(Tag.MOVE, e.t - start, e.kind, here, here, requested, e.arrival - e.t, (),
+                    here, here)
+    x0 = segments[0].x0
+    origin = int(x0) - position if float(x0).is_integer() else x0 - position
+    x, ends = origin, [origin]
+    for s in segments:  # summed relative to the origin: the same in any pass
+        x += (s.v0 + 0.5 * s.a * s.dt) * s.dt
+        ends.append(x)
     return Move(Tag.MOVE, e.t - start, e.kind, e.target - position, origin, requested,
-                e.arrival - e.t, tuple(s.dt for s in e.segments))
+                e.arrival - e.t, tuple(s.dt for s in segments), min(ends), max(ends))
 
 
 def plain(shape: tuple) -> bool:
@@ -390,37 +409,115 @@ def same_shifted_pass(previous: Visit, now: Visit) -> bool:
 
 
 def shifted_passes(now: Visit, period: int, fit: int, bounds: tuple, hard: tuple | None,
-                   reference: float | None = None) -> int:
+                   reference: float | None = None, grid: int = 0) -> int:
     """How many of `fit` passes shifted by now.delta each stay clear of every boundary.
 
     bounds: the soft range (max(JL, -MAX_POSITION), min(JH, MAX_POSITION)) at the anchor;
     hard: the limit switches in present coordinates, or None; reference: the reference
-    switch's edge in present coordinates, or None to skip no pass that shows the switches.
+    switch's edge in present coordinates, or None to skip no pass that shows the switches;
+    grid: ZI of a trigger in grid mode (ZM3), whose pulses divide positions by it, else 0.
     """
     delta, pos = now.delta, now.position
-    if delta and _shows_switches(now.moved):
+    floats = _holds(now.moved, FLOATING)
+    if floats:
+        fit = _same_binade(now, period, fit, grid)
+    if delta and _holds(now.moved, ABSOLUTE):
         if reference is None:
             return 0  # TS shows the switches: where they are crossed is not counted here
         for edge in (reference, *(hard or ())):  # the reference and limit lines (§6.4 TS)
             fit = min(fit, _one_side(now, edge, fit))
+    same_times = None  # passes within the same power of two of time, when first needed
     for move, latest, starts in _moves(now.moved, 0, (0,)):
         for start in starts:
             fit = min(fit, _unclamped(move, pos + start, delta, fit),
                       _clear(move, pos + start, delta, fit, hard))
-        fit = min(fit, _same_arrival(move, now.wake + latest, period, fit))
+        if floats:  # (_same_binade covers the arrivals of a pass with floats)
+            continue
+        arrives = _same_arrival(move, now.wake + latest, period, fit)
+        if arrives < fit:  # an arrival a hair from a whole us (2000.0000000000002 twice)
+            if same_times is None:
+                same_times = _same_time_binade(now, period, fit)
+            arrives = max(arrives, same_times)
+        fit = min(fit, arrives)
     return max(fit, 0)
 
 
-def _shows_switches(shape: tuple) -> bool:
+def _holds(shape: tuple, mark: Absolute) -> bool:
+    """Whether a pass, or a skip inside it, has `mark` (ABSOLUTE: TS; FLOATING: floats)."""
     for item in shape:
         match item:
-            case Absolute():
+            case Absolute() if item == mark:
                 return True
-            case Shifted(shape=inner) if _shows_switches(inner):
+            case Shifted(shape=inner) if _holds(inner, mark):
                 return True
     return False
 
 
+def _span(shape: tuple) -> tuple[float, float]:
+    """The positions a pass visits, relative to its start: its start, its moves (overshoot
+    and all), arrivals and reports, and those of the skips inside it."""
+    low = high = 0
+    for item in shape:
+        match item:
+            case Move():
+                low, high = min(low, item.low, item.target), max(high, item.high, item.target)
+            case Arrive(position=x) | Placed(position=x):
+                low, high = min(low, x), max(high, x)
+            case Shifted(passes=n, shape=inner, position=relative, shift=shift):
+                lo, hi = _span(inner)
+                for start in (relative, relative + (n - 1) * shift):
+                    low, high = min(low, start + lo), max(high, start + hi)
+    return low, high
+
+
+def _same_binade(now: Visit, period: int, fit: int, grid: int = 0) -> int:
+    """Passes that repeat bit for bit a pass computed with fractional positions and times.
+
+    A float x + r (an absolute position or time plus a relative amount) rounds to the grid
+    of x's power of two; moved on by whole counts or microseconds, which that grid divides
+    evenly below 2**52, it rounds alike while it stays within the same power of two and
+    sign, and the difference of two such values is exact (Sterbenz). So the skipped passes
+    compute what the pass just seen computed, moved on, while every position they take (a
+    count of margin) and every time (from the start of the pass before, whose profile may
+    still run, to the last arrival) stays within the powers of two of that pass.
+    """
+    low, high = _span(now.moved)
+    first = now.position - now.delta  # where the pass just seen started
+    lo, hi = math.floor(first + low) - 1, math.ceil(first + high) + 1
+    fit = _within_binade(lo, hi, now.delta, fit)
+    if grid and now.delta % grid == 0:  # grid pulses: position / ZI rounds alike too
+        fit = _within_binade(lo // grid - 1, -(-hi // grid) + 1, now.delta // grid, fit)
+    return _same_time_binade(now, period, fit)
+
+
+def _same_time_binade(now: Visit, period: int, fit: int) -> int:
+    """Passes whose times (from the start of the pass before the one just seen, whose
+    profile may still run, to the last arrival) stay within the power of two of that pass's:
+    their float sums of segment lengths round alike (_same_binade)."""
+    tail = max((latest + move.offset + math.ceil(move.arrival)
+                for move, latest, _ in _moves(now.moved, 0, (0,))), default=0)
+    return _within_binade(now.wake - 2 * period - 1, now.wake + max(period, tail) + 1, period,
+                          fit)
+
+
+def _within_binade(lo: int, hi: int, step: int, fit: int) -> int:
+    """How many of `fit` steps keep lo..hi, moved on by `step` each, within the power of two
+    and the sign it has now (0 if it is not within one now)."""
+    if lo <= 0 <= hi:
+        return 0
+    if hi < 0:
+        lo, hi, step = -hi, -lo, -step
+    top = 1 << hi.bit_length()  # lo..hi must lie in [top / 2, top)
+    if lo < top >> 1:
+        return 0
+    if step > 0:
+        return min(fit, (top - 1 - hi) // step)
+    if step < 0:
+        return min(fit, (lo - (top >> 1)) // -step)
+    return fit
+
+
+EXACT_US = 2**53  # below this, sums of whole floats are exact (_same_arrival)
 FAR = 2**64  # beyond any position (a finite bound: _last_inside divides by the shift)
 
 
@@ -428,11 +525,7 @@ def _one_side(now: Visit, edge: float, fit: int) -> int:
     """Passes that stay, with the pass just seen, on one side of a switch's edge: TS at rest
     shows the reference line (§6.4 FE2) and the limit lines, so its text repeats until a
     pass's span reaches an edge."""
-    low = high = 0  # the span of positions a pass visits, relative to its start
-    for move, _, starts in _moves(now.moved, 0, (0,)):
-        for start in starts:
-            low = min(low, start + move.target, start + move.origin)
-            high = max(high, start + move.target, start + move.origin)
+    low, high = _span(now.moved)
     first = now.position - now.delta  # the pass just seen, whose TS texts the skip repeats
     # a count clear of the edge: Axis.reference_high and limit_switch compare position - DH
     # shift in floats
@@ -482,7 +575,7 @@ def _clear(move: Move, pos: int, delta: int, fit: int, hard: tuple | None) -> in
     if hard is None:
         return fit
     lo, hi = hard[0] + 2, hard[1] - 2
-    low, high = sorted((move.target, move.origin))
+    low, high = min(move.target, move.low), max(move.target, move.high)
     return min(_last_inside(lo - low, hi - low, pos, delta, fit),
                _last_inside(lo - high, hi - high, pos, delta, fit))
 
@@ -490,9 +583,12 @@ def _clear(move: Move, pos: int, delta: int, fit: int, hard: tuple | None) -> in
 def _same_arrival(move: Move, wake: int, period: int, fit: int) -> int:
     """Passes in which the profile's end, summed in floats from its start time, still rounds
     up to the same microsecond: each of the sums adds at most half an ulp of the time."""
-    _, offset, _, _, _, _, arrival, dts = move  # unpacked: any tuple laid out as a Move
+    offset, arrival, dts = move[1], move[6], move[7]  # any tuple laid out as a Move
     if not dts:
         return fit
+    if arrival == sum(dts) and all(float(d).is_integer() for d in dts):
+        # whole microseconds from a command's whole time: every float sum is exact below 2**53
+        return min(fit, max((EXACT_US - wake) // period - 1, 0))
     exact = sum(map(Fraction, dts), Fraction(0))
     up = math.ceil(exact)
     gap = min(exact - (up - 1), up - exact)

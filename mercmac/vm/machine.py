@@ -141,7 +141,7 @@ class Machine:
     clock: Clock = part()
     outputs: Outputs = part()
     axis: Axis = part(shifts=Axis.unshifted)
-    trigger: Trigger = part()
+    trigger: Trigger = part(shifts=Trigger.unshifted)
     model: str = unkeyed("fixed for the machine's life")
     options: Options = unkeyed("fixed for the machine's life")
     on_report: Callable[[float, str], None] | None = unkeyed("the host, not the machine")
@@ -715,11 +715,14 @@ class Machine:
         self.optimiser.code_changed()
 
     # ---------------------------------------------------------------- hardware events
-    def _next_hardware(self) -> float:
-        t = min(self.inputs.next_change(), self.axis.next_event(), self.table_done)
+    def _next_hardware(self, axis: bool = True) -> float:
+        """When the hardware next does something by itself (with `axis`, the axis too)."""
+        t = min(self.inputs.next_change(), self.table_done)
+        if axis:
+            t = min(t, self.axis.next_event())
         if self.outputs.pulse_until > self.clock.now:
             t = min(t, self.outputs.pulse_until)
-        if self.trigger.mode:
+        if self.trigger.mode and axis:  # pulses of the running profile
             t = min(t, self.trigger.next_time(self.axis, self.clock.now))
         return t
 
@@ -771,15 +774,16 @@ class Machine:
         self.wake += jump.passes * jump.period
         if jump.own is not None:
             self.counters[self.chunk.slot][jump.own] -= jump.passes
-        if jump.shift:  # at rest on the target: both move on by whole counts
-            self.axis.rest_at(self.axis.target + jump.passes * jump.shift)
+        # the axis at rest or on its way moves on by whole counts and microseconds
+        self.axis.translate(jump.passes * jump.period, jump.passes * jump.shift)
+        self.trigger.translate(jump.passes * jump.period, jump.passes * jump.shift)
         if self.on_report is not None:  # the host hears every report (mercmac emulate)
             for r in ff.expand(jump.shape, start, jump.period, jump.passes, ff.REPORT,
                                jump.position, jump.shift):
                 self.on_report(r.t / 1000, r.text)
         self._emit(ev.FastForwarded(start, self.wake, jump.passes, jump.period,
                                     self._where_anchor(jump.anchor), jump.shape,
-                                    jump.position, jump.shift))
+                                    jump.position, jump.shift, self.clock.now))
 
     def _busy_loop(self, anchor: Anchor) -> None:
         """The optimiser found a long loop without a wait at `anchor`."""

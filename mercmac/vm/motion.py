@@ -41,6 +41,18 @@ class Ending(NamedTuple):
     side: Side | None = None
 
 
+class Plan(NamedTuple):
+    """What the running profile was planned from (trapezoid.plan's inputs): planned again
+    from the same inputs moved on, it is what stepping plans there (Axis.translate)."""
+
+    t: int  # us, the command's time
+    x: float
+    v: float  # counts/us
+    target: int
+    speed: float  # counts/us
+    acc: float  # counts/us^2
+
+
 class LimitHit(NamedTuple):
     """When the running profile first reaches a limit switch, and which one."""
 
@@ -59,7 +71,10 @@ class Axis:
     defaults: Defaults = unkeyed("the model's power-on values: fixed for the axis's life")
     options: Options = unkeyed("bench facts (switch positions, servo at power-on): fixed "
                                "for the axis's life")
-    segs: tuple[Segment, ...] = key(init=False)  # a tuple: replaced, never changed in place
+    # a tuple: replaced, never changed in place; with plan, the key has them relative to the
+    # time and the target while the axis moves (vm/optimiser.py)
+    segs: tuple[Segment, ...] = key(init=False, shifts=True)
+    plan: Plan | None = key(init=False, shifts=True)  # None: at rest, or not planned (DH, AB1)
     final: float = key(init=False, shifts=True)  # where the axis rests once segs are done
     target: int = key(init=False, shifts=True)
     shift: float = key(init=False)  # coordinates = physical position + shift (DH)
@@ -81,7 +96,7 @@ class Axis:
 
     def reset(self) -> None:
         """Power-on state: position 0 (§3.5.1: "upon power-on ... set to zero")."""
-        self.segs = ()
+        self.segs, self.plan = (), None
         self.final = 0.0
         self.target = 0
         self.shift = 0.0
@@ -127,6 +142,32 @@ class Axis:
         """Still, with its rest position a whole count: a move from here shifts exactly."""
         return not (self.segs or self.stalled or not float(self.final).is_integer())
 
+    def relative(self, now: int) -> tuple | None:
+        """The running profile relative to `now` and the target: what two passes that repeat
+        it (shifted) have alike, fast-forward's key while the axis moves; None when it was
+        not planned by `move` (DH moved it, AB1 stops it) or never ends (a stall)."""
+        p = self.plan
+        if p is None or self.stalled:
+            return None
+        return p.t - now, p.x - self.target, p.v, p.target - self.target, p.speed, p.acc
+
+    def translate(self, dt: int, dx: int) -> None:
+        """Move the axis on by `dt` us and `dx` counts: where the passes a fast-forward skips
+        leave it (vm/optimiser.py). A profile planned from rest on a count is planned again
+        from there, as stepping plans it; any other is moved on, the same floats within one
+        power of two (fastforward._same_binade bounds such skips)."""
+        self.target += dx
+        self.final += dx
+        p = self.plan
+        if p is None:
+            return
+        self.plan = p._replace(t=p.t + dt, x=p.x + dx, target=p.target + dx)
+        if p.v == 0 and float(p.x).is_integer():
+            self.segs = tuple(plan(p.t + dt, p.x + dx, 0.0, p.target + dx, p.speed, p.acc))
+        else:
+            self.segs = tuple(Segment(s.t0 + dt, s.x0 + dx, s.v0, s.a, s.dt) for s in self.segs)
+        self._find_limit()
+
     def soft_range(self) -> tuple[int, int]:
         """Where a target is not clamped: the soft limits within the 32-bit range (§4.4.2)."""
         return max(self.jl, -MAX_POSITION), min(self.jh, MAX_POSITION)
@@ -154,9 +195,12 @@ class Axis:
         speed = (self.sv if vmax is None else vmax) * PER_S
         self.stalled = x != target and (speed <= 0 or self.sa <= 0)
         if self.stalled:  # SV0 or SA0: the profile never gets anywhere
-            self.segs, self.final = (), x
+            self.segs, self.final, self.plan = (), x, None
             return
-        self.segs = tuple(plan(t, x, v, target, speed, self.sa * PER_S2))
+        self.plan = Plan(t, x, v, target, speed, self.sa * PER_S2)
+        self.segs = tuple(plan(*self.plan))
+        if not self.segs:
+            self.plan = None
         self.final = float(target)
         if self.segs:
             self.negative = self.segs[-1].v0 < 0
@@ -166,6 +210,7 @@ class Axis:
         """AB: profile velocity zero at once, target := position (§6.4 AB)."""
         self.final = self.position(t)
         self.segs, self.stalled, self.homing, self.limit = (), False, False, None
+        self.plan = None
         self.target = round(self.final)
 
     def decelerate(self, t: float) -> None:
@@ -173,6 +218,7 @@ class Axis:
         if self.sa <= 0:
             return self.halt(t)
         self.segs = tuple(stop(t, self.position(t), self.velocity(t) * PER_S, self.sa * PER_S2))
+        self.plan = None
         self.final = self.segs[-1].x(self.segs[-1].t1) if self.segs else self.position(t)
         self.target, self.stalled, self.homing = round(self.final), False, False
         self._find_limit()
@@ -182,6 +228,7 @@ class Axis:
         delta = value - self.position(t)
         self.shift += delta
         self.segs = tuple(Segment(s.t0, s.x0 + delta, s.v0, s.a, s.dt) for s in self.segs)
+        self.plan = None
         self.final += delta
         self.target = round(self.target + delta)
 
@@ -238,7 +285,7 @@ class Axis:
             self.target = round(self.final)
             return Ending(Ended.LIMIT, side)
         if self.segs and self.arrival() <= t:
-            self.segs = ()
+            self.segs, self.plan = (), None
             self.referenced = self.referenced or (self.homing and self.edge_ahead)
             self.homing = False
             return Ending(Ended.ARRIVED)

@@ -123,19 +123,40 @@ class Optimiser:
         self.log.append(ff.Requested(target, *self.machine.axis.soft_range()))
 
     def profile_starting(self) -> None:
-        """A profile starts; one that does not start from rest on a count does not shift."""
-        if not self.machine.axis.at_rest_on_count():  # floats would differ
+        """A profile starts: from rest on a count it shifts exactly in any pass; from a moving
+        or a fractional state, only as floats within one power of two (Note.FLOATS); from a
+        profile it cannot key (DH moved it, AB1, a stall), not at all."""
+        axis = self.machine.axis
+        if axis.at_rest_on_count():
+            return
+        if axis.stalled or (axis.segs and axis.plan is None):
             self.log.append(Note.UNSHIFTABLE)
+        else:
+            self.log.append(Note.FLOATS)
 
     def reported(self, mnemonic: str) -> None:
-        """Note how the report just made depends on the position (fastforward.moved_shape)."""
+        """Note how the report just made depends on the position (fastforward.moved_shape):
+        TT shows the target; at rest on a count TP and TD show it, TS the switches; while
+        moving, TP, TD and TE round a float position, TV shows a velocity and TS the
+        switches and the motion, all the same a pass later within one power of two."""
         if mnemonic not in POSITIONAL:
             return
         axis = self.machine.axis
         if mnemonic == Mnemonic.TT:
             self.log.append(ff.Shows(COMMANDS[mnemonic].report, axis.target))
-        elif not axis.at_rest_on_count():
-            self.log.append(Note.UNSHIFTABLE)
+            return
+        if not axis.at_rest_on_count():
+            now = self.machine.clock.now
+            x = axis.position(now)
+            if axis.stalled or (axis.segs and axis.plan is None) or x - math.floor(x) == 0.5:
+                # round() takes a half to the even count: a pass an odd count on differs
+                self.log.append(Note.UNSHIFTABLE)
+                return
+            if mnemonic in (Mnemonic.TP, Mnemonic.TD):  # (a Shows follows its report)
+                self.log.append(ff.Shows(COMMANDS[mnemonic].report, round(x)))
+            elif mnemonic == Mnemonic.TS:
+                self.log.append(Note.SWITCHES)
+            self.log.append(Note.FLOATS)
         elif mnemonic == Mnemonic.TS:
             self.log.append(Note.SWITCHES)
         elif mnemonic in (Mnemonic.TP, Mnemonic.TD):
@@ -147,7 +168,8 @@ class Optimiser:
             self.log.append(Note.UNSHIFTABLE)
 
     def pulsed(self) -> None:
-        self.log.append(Note.UNSHIFTABLE)
+        """A trigger pulse: its time comes from where the profile reaches a position."""
+        self.log.append(Note.FLOATS)
 
     # ------------------------------------------------------------ at a loop anchor
     def _arrive(self, anchor: Anchor, own: int | None, remaining: float) -> None:
@@ -175,10 +197,14 @@ class Optimiser:
                       remaining: float) -> None:
         """Skip passes that repeat `visit.delta` further on, up to the next boundary."""
         period = visit.wake - previous.wake
-        fit = ff.skippable(previous, visit, self._bound(), remaining)
+        # the running profile's arrival is the pass's own (its shape has it; its limit hit is a
+        # boundary, shifted_passes): only other hardware events bound the skip
+        fit = ff.skippable(previous, visit, self._bound(axis=False), remaining)
         axis = self.machine.axis
+        trigger = self.machine.trigger
+        grid = abs(trigger.increment) if trigger.mode == 3 else 0
         passes = ff.shifted_passes(visit, period, fit, axis.soft_range(), axis.switches(),
-                                   axis.options.reference_at + axis.shift)
+                                   axis.options.reference_at + axis.shift, grid)
         if passes < fit:  # a boundary, not the counter, ends it: enclosing passes differ
             self.log.append(Note.UNSHIFTABLE)
         if passes > 0:
@@ -195,9 +221,10 @@ class Optimiser:
                                          self.log_base + len(self.log), visit.shape,
                                          skey, position, visit.delta, visit.moved)
 
-    def _bound(self) -> float:
-        """What a jump must stop before: the end of the run or the next hardware event."""
-        return min(self.horizon, self.machine._next_hardware())
+    def _bound(self, axis: bool = True) -> float:
+        """What a jump must stop before: the end of the run or the next hardware event (but
+        the axis's own, without `axis`)."""
+        return min(self.horizon, self.machine._next_hardware(axis))
 
     def _busy_loop(self, anchor: Anchor, key: tuple | None, previous: Visit) -> None:
         """A long pass without a wait came round: a busy loop, if it is a loop. Reported
@@ -227,16 +254,29 @@ class Optimiser:
                      self.log_base + len(self.log), pass_shape, skey, position, delta, moved)
 
     def _key(self, own: int | None) -> tuple | None:
-        """The machine's state key (Machine.STATE_KEY); None while the axis moves."""
+        """The machine's state key (Machine.STATE_KEY); while the axis moves, with its profile
+        relative to now and the target (Axis.relative), or None if it has none."""
         m = self.machine
-        if m.axis.segs or m.axis.moving(m.clock.now):
-            return None
-        return m._state_key(own)
+        key = m._state_key(own)
+        axis = m.axis
+        if axis.segs or axis.stalled:
+            relative = axis.relative(m.clock.now)
+            if relative is None:
+                return None
+            return m.unshifted(key), relative, axis.target, axis.final
+        return key
 
     def _shift_key(self, key: tuple | None) -> tuple[tuple | None, int]:
         """The state key without the axis's position and target, and the target; (None, 0)
-        unless the axis rests on its target, a whole count, with no trigger set."""
+        unless the axis rests on its target, a whole count, or moves on a profile it keys;
+        with the trigger relative to the target (Trigger.relative)."""
         m = self.machine
-        if key is None or m.axis.final != m.axis.target or m.trigger.mode:
+        if key is None:
             return None, 0
-        return m.unshifted(key), m.axis.target
+        axis = m.axis
+        trigger = m.trigger.relative(axis.target)
+        if axis.segs:  # (unshifted, relative, target, final)
+            return (key[0], key[1], axis.final - axis.target, trigger), axis.target
+        if axis.final != axis.target:
+            return None, 0
+        return (m.unshifted(key), trigger), axis.target

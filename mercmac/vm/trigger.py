@@ -22,11 +22,13 @@ class Trigger:
     mode: int = key(init=False)  # ZM: 0 off, 1 single, 2 multiple, 3 grid
     position: int = key(init=False)  # ZP
     increment: int = key(init=False)  # ZI
-    next_at: int = key(init=False)  # where the next pulse of mode 1 or 2 fires
+    # where the next pulse of mode 1 or 2 fires; a shifted pass keys it relative to the
+    # target (`relative`)
+    next_at: int = key(init=False, shifts=True)
     done: bool = key(init=False)  # single mode has fired
-    # a time, compared with the pulse times of a profile; the key is taken only while
-    # no profile runs, and a pass that moves never repeats
-    last_t: float = unkeyed("the time of the last pulse", init=False)
+    # a time, compared with the pulse times of a profile: only a pulse of the running
+    # profile can be as late, and a skip moves it on with the profile (`translate`)
+    last_t: float = unkeyed("the time of the last pulse, moved on by a skip", init=False)
 
     def __post_init__(self):
         self.reset()
@@ -41,6 +43,23 @@ class Trigger:
         self.next_at = self.position
         self.last_t = -math.inf
         self.done = False
+
+    def relative(self, target: int) -> tuple:
+        """What decides the next pulses relative to the target: the same in two passes that
+        repeat shifted (vm/optimiser.py). Multiple mode fires at next_at, then ZI further on;
+        grid mode at multiples of ZI, the same relative to a target a whole number of ZI on."""
+        if self.mode == 2 or (self.mode == 1 and not self.done):
+            return self.next_at - target,
+        if self.mode == 3 and self.increment:
+            return target % abs(self.increment),
+        return ()
+
+    def translate(self, dt: int, dx: int) -> None:
+        """Moved on with the axis by a skip of passes (Axis.translate): multiple mode's next
+        position as the pulses of the skipped passes moved it, the last pulse's time."""
+        if self.mode == 2:
+            self.next_at += dx
+        self.last_t += dt
 
     def next_time(self, axis: Axis, now: float) -> float:
         """The time of the next pulse after `now` (inf if none while the profile runs)."""

@@ -101,8 +101,14 @@ def test_a_button_release_is_a_boundary():
 
 
 def test_an_arrival_that_floats_could_round_otherwise_is_not_skipped_that_far():
-    # a profile lasting a whole number of us plus nothing: no time is safe
+    # segments of whole microseconds from a command's whole time: every float sum is exact
+    # below 2**53 us, and no further
     item = (ff.MOVE, 0, "move", 1, 0, None, 3, (1.0, 2.0))
+    assert ff._same_arrival(item, 0, 10, 100) == 100
+    assert ff._same_arrival(item, 2**53 - 1000, 10, 10**6) < 100
+    # a hair over a whole number of us (the C-663's 2000.0000000000002 twice): the sum rounds
+    # either way with the time, so no time is safe by this rule (_same_time_binade's is)
+    item = (ff.MOVE, 0, "move", 1, 0, None, 4000, (2000.0000000000002, 2000.0000000000002))
     assert ff._same_arrival(item, 0, 10, 100) == 0
     # 0.25 us from the next microsecond: safe while an ulp of the time is far smaller
     item = (ff.MOVE, 0, "move", 1, 0, None, 4, (1.5, 2.25))

@@ -14,6 +14,8 @@ from mercmac.vm import Machine
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
 from mercmac.vm.machine import Blocked, Return, Wait
+from mercmac.vm.motion import Axis
+from mercmac.vm.trigger import Trigger
 from mercmac.vm.optimiser import FastForward, Optimiser
 from mercmac.vm.statekey import key, keyed, part, unkeyed
 
@@ -94,15 +96,22 @@ def test_a_key_is_generated_from_the_marks_with_parts_and_shifts():
     assert outer.state_key() == (("k",), (1, 2)) and Outer.unshifted(outer.state_key()) == (("k",), 1)
 
 
-def test_the_machines_shift_key_leaves_out_the_axis_position_and_target_only():
+def test_the_machines_shift_key_leaves_out_positions_targets_and_profiles_only():
+    # the profile (segs and the plan it came from) is keyed relative to the time and the
+    # target while the axis moves (Axis.relative), and is () and None at rest
     m = Machine(program_of("[MC00] MR5,WS0,WA10,RP\n"))
     m.power_on()
     m.run_until(50)
     whole, shifted = m._state_key(None), m.unshifted(m._state_key(None))
     at = Machine.STATE_KEY.index("axis")
-    axis = list(whole[at])
-    del axis[1:3]  # Axis.STATE_KEY: segs, final, target, ...
-    assert shifted == whole[:at] + (tuple(axis),) + whole[at + 1:]
+    shifting = {"segs", "plan", "final", "target"}
+    axis = [v for name, v in zip(Axis.STATE_KEY, whole[at]) if name not in shifting]
+    expected = list(whole[:at] + (tuple(axis),) + whole[at + 1:])
+    # and the trigger's next position, keyed relative to the target (Trigger.relative)
+    trigger = Machine.STATE_KEY.index("trigger")
+    expected[trigger] = tuple(v for name, v in zip(Trigger.STATE_KEY, whole[trigger])
+                              if name != "next_at")
+    assert shifted == tuple(expected)
 
 
 # -- shapes are typed records, walked by fastforward ---------------------------------------
