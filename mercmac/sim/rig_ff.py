@@ -4,18 +4,21 @@ One machine's fast-forward (vm/optimiser.py) sees only its own state, and a mach
 waits on a wired input cannot know when the other side will answer; so in a rig each
 machine runs instant by instant (sim/rig.py) and this module compares the joint state.
 
-A joint anchor is an instant after which every axis rests on a whole-count target, with no
-trigger set, no trigger pulse on, no JT table being made. The joint key there is every
-machine's state key (vm/statekey.py) without position and target (`unshifted`), its input
-lines, its next command relative to now, and every wire's level. When the key comes back,
+A joint anchor is an instant after which every axis rests on a whole-count target or moves
+on a profile it keys relative to the time and target (issue 19), with no trigger pulse on
+and no JT table being made. The joint key there is every machine's state key
+(vm/statekey.py) without position, target and profile (`unshifted`), the profile and the
+trigger relative to the target, its input lines, its next command relative to now, and
+every wire's level. When the key comes back,
 the rig passed through a pass; when two passes in a row have the same shape (per machine:
 moves, arrivals, reports, output changes relative to the pass's start time and position,
 fastforward.moved_shape) and the same shifts, the next passes are copies, each `period`
 later and `delta` further on per axis, until a button or joystick change, the end of the
 run, or a boundary of a shifted move (a soft limit, a switch, an arrival that could round
-to another microsecond: fastforward.shifted_passes) — the rules of the single machine,
-applied to all at once. What a pass does that cannot shift exactly (a hazard, a search, a
-limit hit, a report while moving) makes its shape None, and the rig steps it.
+to another microsecond, a power of two of positions or time for a pass that computes with
+fractions: fastforward.shifted_passes) — the rules of the single machine, applied to all at
+once. What a pass does that cannot shift exactly (a hazard, a search, a limit hit) makes
+its shape None, and the rig steps it.
 """
 from __future__ import annotations
 
@@ -136,7 +139,7 @@ class JointForward:
             if not ff.plain(shape):
                 now = ff.Visit(None, visit.t, 0, 0, 0, None, (), visit.positions[i],
                                visit.deltas[i], shape)
-                fit = ff.shifted_passes(now, period, fit, m.axis.soft_range(), m.axis.switches())
+                fit = ff.shifted_passes(now, period, fit, *m.optimiser.boundaries())
         return fit
 
     # ------------------------------------------------------------ the skip
@@ -166,31 +169,42 @@ class JointForward:
             sim.edges_dropped += count * passes
             return
         for p in range(1, passes + 1):
-            shift_ms = p * period / 1000
-            for edge in listed:
-                sim.add_edge(type(edge)(edge.t_ms + shift_ms, edge.wire, edge.level))
+            for edge in listed:  # from whole microseconds, as stepping times them (t / 1000)
+                t = round(edge.t_ms * 1000) + p * period
+                sim.add_edge(type(edge)(t / 1000, edge.wire, edge.level))
             if len(sim.edges) >= CAP:
                 sim.edges_dropped += count * (passes - p)
                 return
 
 
 def _machine_key(m: Machine, t: int) -> tuple | None:
-    """One machine's part of the joint key; None unless it rests on a whole-count target with
-    nothing timed going on (a pulse, a trigger, a JT table)."""
-    axis = m.axis
-    if (axis.segs or axis.final != axis.target or m.trigger.mode or m.table_done != INF
-            or m.outputs.pulse_until > t):
+    """One machine's part of the joint key, its position, target, profile and trigger relative
+    to the target and to t (as its own fast-forward keys them, vm/optimiser.py); None when a
+    pulse is on, a JT table is being made, or the axis rests off a whole count or moves on a
+    profile it cannot key."""
+    if m.table_done != INF or m.outputs.pulse_until > t:
         return None
+    axis = m.axis
+    motion = ()
+    if axis.segs or axis.stalled:
+        relative = axis.relative(t)
+        if relative is None:
+            return None
+        motion = relative, axis.final - axis.target
+    elif axis.final != axis.target:
+        return None
+    trigger = m.trigger.relative(axis.target)
     if m.chunk is None:  # nothing runs: only its axis and outputs go on (a joystick)
-        return ("halted", axis.unshifted(axis.state_key()), m.outputs.state_key(),
-                m.deflection, tuple(m.inputs.state))
+        return ("halted", axis.unshifted(axis.state_key()), motion, trigger,
+                m.outputs.state_key(), m.deflection, tuple(m.inputs.state))
     key = list(m._state_key(None))
     key[_COUNTERS] = tuple(sorted(_counters(m)))  # which RPs count; by how much: _spent
     block = m.block
     if block is not None:  # when it began matters only for the first cycle after
         key[_BLOCK] = (block.wait, block.arg, min(t - block.began, m.clock.cycle))
     running = m.chunk is not None and block is None
-    return m.unshifted(tuple(key)), tuple(m.inputs.state), m.wake - t if running else None
+    return (m.unshifted(tuple(key)), motion, trigger, tuple(m.inputs.state),
+            m.wake - t if running else None)
 
 
 def _counters(m: Machine) -> dict[tuple[int, int], int]:
@@ -225,8 +239,8 @@ def _shift_machine(m: Machine, span: int, moved: int, spent: dict, passes: int) 
     m.wake += span
     if m.block is not None:
         m.block = m.block._replace(began=m.block.began + span)
-    if moved:
-        m.axis.rest_at(m.axis.target + moved)
+    m.axis.translate(span, moved)  # at rest or on its way, as the optimiser's jump moves it
+    m.trigger.translate(span, moved)
 
 
 def where(m: Machine) -> ev.Where | None:

@@ -17,9 +17,11 @@ count (and list, up to their cap) exactly what plain stepping would have emitted
 Passes that move, report a hazard or see an input change never repeat this way.
 
 Shifted passes (issue 11, item 3: a jog loop with a button held, a scan stepping
-forever): a pass that starts at rest on an integer target and makes moves from
-rest is the same pass, `delta` counts further on, when the machine state apart
-from the position and target is the same. Two such passes in a row with the
+forever): a pass is the same pass, `delta` counts further on, when the machine
+state apart from the position and target is the same; the axis may rest on a whole
+count or, at the anchor, still run the profile a pass started (issue 19), keyed by
+what it was planned from relative to the time and the target (Axis.relative), and
+the trigger by where it fires relative to the target (Trigger.relative). Two such passes in a row with the
 same `moved_shape` (moves, arrivals and position reports relative to the pass's
 start position) and the same delta are copies; the skip (`shifted_passes`)
 stops before the next boundary: a soft limit or +-MAX_POSITION clamp, a hard
@@ -27,9 +29,13 @@ limit switch, the end of the run, an input change, the RP counter's end, and the
 time from which the float sum of a profile's segment lengths could round to
 another arrival microsecond; and for a pass that reads TS (issue 19), the edges
 of the reference and limit switches, whose lines its text shows (`_one_side`).
-What a pass does that cannot shift exactly (a report or a command while the axis
-moves, a trigger, a reference search, DH, a limit hit) leaves `Note.UNSHIFTABLE`
-in the effect log and makes the pass unskippable.
+A pass that computes with fractional positions (a move started on the way, a
+report or a trigger pulse while the axis moves: `Note.FLOATS`) repeats bit for
+bit only while its positions and times stay within the powers of two of the pass
+seen (`_same_binade`), which bound its skips too. What a pass does that cannot
+shift exactly (ZM/ZP/ZI in the pass, a reference search, DH, AB1, a limit hit, a
+position exactly half-way when reported) leaves `Note.UNSHIFTABLE` in the effect
+log and makes the pass unskippable.
 """
 from __future__ import annotations
 

@@ -290,8 +290,3 @@ class Axis:
             self.homing = False
             return Ending(Ended.ARRIVED)
         return None
-
-    def rest_at(self, target: int) -> None:
-        """At rest on the target, both move to `target` (a shifted skip, vm/optimiser.py)."""
-        self.target = target
-        self.final = float(target)

@@ -28,8 +28,9 @@ LOG_LIMIT = 100_000  # effects kept for comparing passes; a longer pass is not s
 
 FLOW = (ev.MacroEntered, ev.MacroLeft, ev.Executed)  # control flow: repeats with the pass
 
-# reports that show the position: TP, TD, TT shift with it; TE and TV do not at rest;
-# TS shows the limit and reference switches; all but TT vary while moving
+# reports that depend on the position or the motion: TP, TD, TT shift with it; TE and TV
+# do not at rest; TS shows the limit and reference switches; while moving, all but TT take
+# a fractional position (Optimiser.reported)
 POSITIONAL = {Mnemonic.TP, Mnemonic.TD, Mnemonic.TT, Mnemonic.TE, Mnemonic.TV, Mnemonic.TS}
 
 
@@ -163,7 +164,8 @@ class Optimiser:
             self.log.append(ff.Shows(COMMANDS[mnemonic].report, int(axis.final)))
 
     def trigger_set(self) -> None:
-        """ZM, ZP or ZI: pulses at positions are not counted as boundaries."""
+        """ZM, ZP or ZI in a pass: it arms the trigger at ZP, a position that does not move
+        on with the pass (Trigger.relative keys a trigger armed before the loop)."""
         if self.machine.trigger.mode:
             self.log.append(Note.UNSHIFTABLE)
 
@@ -200,16 +202,20 @@ class Optimiser:
         # the running profile's arrival is the pass's own (its shape has it; its limit hit is a
         # boundary, shifted_passes): only other hardware events bound the skip
         fit = ff.skippable(previous, visit, self._bound(axis=False), remaining)
-        axis = self.machine.axis
-        trigger = self.machine.trigger
-        grid = abs(trigger.increment) if trigger.mode == 3 else 0
-        passes = ff.shifted_passes(visit, period, fit, axis.soft_range(), axis.switches(),
-                                   axis.options.reference_at + axis.shift, grid)
+        passes = ff.shifted_passes(visit, period, fit, *self.boundaries())
         if passes < fit:  # a boundary, not the counter, ends it: enclosing passes differ
             self.log.append(Note.UNSHIFTABLE)
         if passes > 0:
             self._jump(Jump(anchor, own, passes, period, visit.moved, visit.position,
                             visit.delta), visit)
+
+    def boundaries(self) -> tuple:
+        """What bounds a shifted skip here (fastforward.shifted_passes): the soft range, the
+        limit switches, the reference edge in present coordinates, a grid trigger's ZI."""
+        axis, trigger = self.machine.axis, self.machine.trigger
+        grid = abs(trigger.increment) if trigger.mode == 3 else 0
+        return (axis.soft_range(), axis.switches(), axis.options.reference_at + axis.shift,
+                grid)
 
     def _jump(self, jump: Jump, visit: Visit) -> None:
         """Have the machine jump, then arrive again: the jump's own event belongs to enclosing

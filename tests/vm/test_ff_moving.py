@@ -139,7 +139,8 @@ def test_a_skip_stops_where_a_power_of_two_is_crossed():
 body = st.lists(st.sampled_from([
     ("MR", 1), ("MR", -3), ("MR", 17), ("MR", 250), ("MA", 900), ("WS", 0), ("WA", 1),
     ("WA", 3), ("TP", None), ("TD", None), ("TE", None), ("TV", None), ("TT", None),
-    ("TS", None), ("CN", 1), ("CF", 1), ("SV", 3000)]), min_size=1, max_size=7)
+    ("TS", None), ("CN", 1), ("CF", 1), ("SV", 3000), ("AB", None), ("ST", None)]),
+    min_size=1, max_size=7)
 start = st.sampled_from([0, 61, -5, 1020, 4094, -70_000, 2**20 - 40])
 tail = st.sampled_from([[("RP", 65535)], [("WA", 2), ("RP", 30), ("RP", 65535)],
                         [("EM", 4)], [("EM", 3)]])

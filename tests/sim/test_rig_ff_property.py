@@ -1,0 +1,88 @@
+"""Joint fast-forward of a rig against stepping it (issue 19): two controllers wired to each
+other, running random programs that move, move on the way, report while moving, set the
+trigger, and wait on each other's lines, give the same wire edges, reports, outputs,
+hazards and final state whether the rig's repeating passes are skipped or stepped."""
+from __future__ import annotations
+
+import shutil
+import tempfile
+from pathlib import Path
+from unittest import mock
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from helpers.budgets import budget
+from helpers.rig_sim import rig_of
+from mercmac.compiler import compile_file
+from mercmac.rig.load import read_rig
+from mercmac.sim import record as record_module
+from mercmac.sim.rig import simulate_rig
+from mercmac.vm import events as ev
+
+WIRES = '"x.out1 -> y.in1", "y.out2 -> x.in2"'
+
+
+def run(path: Path, until_ms: int, fast_forward: bool):
+    rig = read_rig(str(path)).rig
+    programs = {c.name: compile_file(c.program, target=c.model).program for c in rig.controllers}
+    with mock.patch.object(record_module, "CAP", 10**7):  # every event listed: comparable
+        return simulate_rig(rig, programs, until_ms=until_ms, fast_forward=fast_forward)
+
+
+def outcome(result) -> dict:
+    """What a rig run shows: edges, and per controller its record and final machine."""
+    seen = {"edges": [(e.t_ms, str(e.wire), e.level) for e in result.edges],
+            "dropped": result.edges_dropped}
+    for name, r in result.runs.items():
+        m = r.machine
+        seen[name] = (r.final(), [(e.t, e.pattern) for e in r.record.outputs],
+                      [(e.t, e.text) for e in r.record.reports], dict(r.record.dropped),
+                      [(h.t, h.message) for h in r.record.hazards],
+                      [e for e in r.record.events if not isinstance(e, ev.FastForwarded)
+                       and not isinstance(e, ev.MoveStarted)],
+                      # a blocked machine's next command time is unused (it is set when the
+                      # wait ends), and a skip moves it on with the clock
+                      m.counters, m.ip, m.wake if m.block is None else None, m.axis.segs,
+                      m.axis.final, m.axis.plan)
+    return seen
+
+
+def skipped(result) -> int:
+    return sum(e.passes for r in result.runs.values() for e in r.record.events
+               if isinstance(e, ev.FastForwarded))
+
+
+x_ops = st.lists(st.sampled_from(["MR3", "MR-1", "MR40", "WS0", "WA2", "WA5", "TP", "TT", "TV",
+                                  "CN1", "CF1", "WN2", "WF2", "TS"]), min_size=1, max_size=6)
+y_ops = st.lists(st.sampled_from(["WN1", "WF1", "MR2", "MR17", "WS0", "WA1", "TP", "TE",
+                                  "CN2", "CF2"]), min_size=1, max_size=6)
+tails = st.sampled_from(["RP,RP", "WA3,RP,RP", "EM1"])
+prologues = st.sampled_from(["", "ZM2,ZP0,ZI5,", "MA-70000,WS0,", "MA1020,WS0,"])
+
+
+@pytest.mark.slow
+@settings(max_examples=budget(60), deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(x_ops, y_ops, tails, tails, prologues, st.integers(300, 6_000))
+def test_a_wired_rig_skipped_gives_what_stepping_gives(xs, ys, x_tail, y_tail, prologue,
+                                                        until_ms):
+    folder = Path(tempfile.mkdtemp())
+    try:
+        path = rig_of(folder, f"[MC00] {prologue}EM1\n[MC01] {','.join(xs)},{x_tail}\n",
+                      f"[MC00] EM1\n[MC01] {','.join(ys)},{y_tail}\n", WIRES)
+        fast = run(path, until_ms, True)
+        plain = run(path, until_ms, False)
+        assert outcome(fast) == outcome(plain)
+    finally:
+        shutil.rmtree(folder)
+
+
+def test_a_rig_that_moves_on_the_way_skips_together(tmp_path):
+    # x reports and steps on the way, 1 count a pass, and pulses y, which steps along
+    path = rig_of(tmp_path, "[MC00] EM1\n[MC01] TT,MR1,CN1,WA1,CF1,RP,RP\n",
+                  "[MC00] EM1\n[MC01] WN1,MR1,TP,WF1,RP,RP\n", WIRES)
+    fast, plain = run(path, 20_000, True), run(path, 20_000, False)
+    assert outcome(fast) == outcome(plain)
+    assert skipped(fast) > 1000
