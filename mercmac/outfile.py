@@ -30,11 +30,9 @@ from __future__ import annotations
 
 import contextlib
 import errno
-import hashlib
 import os
 import signal
 import stat
-import tempfile
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -74,6 +72,8 @@ class Snapshot(NamedTuple):
 def snapshot(path: str | os.PathLike, data: bytes) -> Snapshot:
     """The snapshot of PATH, just read as DATA (stat after the read: a change in between
     shows as a size or a digest that does not match)."""
+    import hashlib  # here: a run that writes no file does not import it (start-up, issue 19)
+
     return Snapshot(len(data), os.stat(path).st_mtime_ns, hashlib.sha256(data).digest())
 
 
@@ -148,6 +148,8 @@ def drafting(path: str | os.PathLike, *, binary: bool = False, encoding: str = "
     target = writable_target(path, make_parents=make_parents)
     with _terminable(path):
         try:
+            import tempfile  # here: start-up of runs that write no file
+
             fd, tmp = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=TEMP_SUFFIX, dir=target.parent)
         except OSError as e:
             raise OutputError(f"cannot write {path}: {reason(e)}") from None
@@ -212,6 +214,8 @@ def _unchanged(target: Path, expect: Snapshot | None, path) -> None:
 
 
 def _digest(path: Path) -> bytes:
+    import hashlib
+
     digest = hashlib.sha256()
     with open(path, "rb") as f:
         for block in iter(lambda: f.read(1 << 20), b""):
@@ -260,6 +264,8 @@ def _restore(keep: str, target: Path, path, cause: BaseException) -> None:
 
 def _copy_beside(target: Path) -> str:
     """A durable copy of TARGET's bytes in its folder: what a failed in-place write restores."""
+    import tempfile
+
     fd, keep = tempfile.mkstemp(prefix=TEMP_PREFIX, suffix=TEMP_SUFFIX, dir=target.parent)
     try:
         with os.fdopen(fd, "wb") as out, open(target, "rb") as old:

@@ -74,6 +74,9 @@ def _write(o: object, out: list[str], nl: str) -> None:
             return
         inner = nl + INDENT
         members, flat = inner + INDENT, _flat(inner + INDENT)  # of flat objects in the list
+        if all(type(v) is dict and v and _flat_types(tuple(map(type, v.values()))) for v in o):
+            out.append(_records(o, nl, inner, members))
+            return
         opening, closing = "{" + members, inner + "}"
         sep = "[" + inner
         for v in o:
@@ -88,6 +91,18 @@ def _write(o: object, out: list[str], nl: str) -> None:
         out.append(nl + "]")
     else:
         out.append(_scalar(o))
+
+
+def _records(o: list | tuple, nl: str, inner: str, members: str) -> str:
+    """A list of flat objects (a simulation's events): written by the C encoder in one call,
+    every separator the members' one, then each "}" + separator + "{" between two objects
+    made the list's. A string cannot hide that sequence: the encoder escapes a newline, and
+    a scalar member ends with a quote, a digit or a letter, never with "}"."""
+    text = _flat(members)(o)  # "[{" m1 "}," members "{" m2 "}]"
+    between = "}," + members + "{"
+    return ("[" + inner + "{" + members
+            + text[2:-2].replace(between, inner + "}," + inner + "{" + members)
+            + inner + "}" + nl + "]")
 
 
 def _scalar(v: object) -> str:

@@ -19,7 +19,7 @@ import math
 import os
 import re
 from bisect import bisect_left, bisect_right
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 from mercmac.errors import InputError
 from mercmac.outfile import replacing, writable_target
@@ -176,7 +176,7 @@ class PlotObserver:
                                     (skip.t_to, float(skip.position + moved))]
             self.trace.target.append((skip.t_to, self.trace.target[-1][1] + moved))
         # a move running across the skip's end runs on as the copy of the one before it
-        self.segments = tuple(replace(seg, t0=seg.t0 + span, x0=seg.x0 + moved)
+        self.segments = tuple(seg._replace(t0=seg.t0 + span, x0=seg.x0 + moved)
                               for seg in self.segments)
         self.sampled_to = skip.t_to
 

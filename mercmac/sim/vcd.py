@@ -9,7 +9,6 @@ The dump stops cleanly before it would pass `limit` bytes; `cut_at` says when.
 """
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import IO
 
 from vcd import VCDWriter
@@ -131,7 +130,7 @@ class VcdObserver:
         dt, dx = (skip.passes - 1) * skip.period, (skip.passes - 1) * skip.shift
         for move in [m for m in self.moves if skip.t - skip.period <= m.t < skip.t]:
             changes.append((move.t + skip.period + dt, self.target, move.target + skip.shift + dx))
-            segments = tuple(replace(seg, t0=seg.t0 + skip.period + dt,
+            segments = tuple(seg._replace(t0=seg.t0 + skip.period + dt,
                                      x0=seg.x0 + skip.shift + dx) for seg in move.segments)
             if segments:
                 end = min(int(segments[-1].t1), skip.t_to - 1)
