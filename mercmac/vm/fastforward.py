@@ -484,12 +484,14 @@ def _same_binade(now: Visit, period: int, fit: int, grid: int = 0) -> int:
     evenly below 2**52, it rounds alike while it stays within the same power of two and
     sign, and the difference of two such values is exact (Sterbenz). So the skipped passes
     compute what the pass just seen computed, moved on, while every position they take (a
-    count of margin) and every time (from the start of the pass before, whose profile may
-    still run, to the last arrival) stays within the powers of two of that pass.
+    count of margin) and every time stays within the powers of two of that pass and of the
+    one before it: the profile still running at the anchor was planned there, and the key
+    holds it relative to the target (Axis.relative), a difference exact only within them.
     """
     low, high = _span(now.moved)
     first = now.position - now.delta  # where the pass just seen started
-    lo, hi = math.floor(first + low) - 1, math.ceil(first + high) + 1
+    before = first - now.delta  # and the one before it
+    lo, hi = math.floor(min(first, before) + low) - 1, math.ceil(max(first, before) + high) + 1
     fit = _within_binade(lo, hi, now.delta, fit)
     if grid and now.delta % grid == 0:  # grid pulses: position / ZI rounds alike too
         fit = _within_binade(lo // grid - 1, -(-hi // grid) + 1, now.delta // grid, fit)
@@ -497,9 +499,9 @@ def _same_binade(now: Visit, period: int, fit: int, grid: int = 0) -> int:
 
 
 def _same_time_binade(now: Visit, period: int, fit: int) -> int:
-    """Passes whose times (from the start of the pass before the one just seen, whose
-    profile may still run, to the last arrival) stay within the power of two of that pass's:
-    their float sums of segment lengths round alike (_same_binade)."""
+    """Passes whose times (from the start of the pass before the one just seen to the last
+    arrival) stay within the power of two of those two passes': their float sums of segment
+    lengths round alike (_same_binade)."""
     tail = max((latest + move.offset + math.ceil(move.arrival)
                 for move, latest, _ in _moves(now.moved, 0, (0,))), default=0)
     return _within_binade(now.wake - 2 * period - 1, now.wake + max(period, tail) + 1, period,

@@ -269,7 +269,7 @@ class Optimiser:
             relative = axis.relative(m.clock.now)
             if relative is None:
                 return None
-            return m.unshifted(key), relative, axis.target, axis.final
+            return m.unshifted(key), relative, axis.target, axis.final, m.trigger.next_at
         return key
 
     def _shift_key(self, key: tuple | None) -> tuple[tuple | None, int]:
