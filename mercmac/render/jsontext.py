@@ -46,51 +46,38 @@ def _unserializable(o: object) -> None:
     raise TypeError(f"Object of type {type(o).__name__} is not JSON serializable")
 
 
+def _flat_object(v: object) -> bool:
+    """A non-empty object of scalars only."""
+    return type(v) is dict and bool(v) and _flat_types(tuple(map(type, v.values())))
+
+
 def _write(o: object, out: list[str], nl: str) -> None:
+    if not isinstance(o, _NESTED):
+        out.append(_scalar(o))
+        return
+    if not o:
+        out.append("{}" if isinstance(o, dict) else "[]")
+        return
+    inner = nl + INDENT
     if isinstance(o, dict):
-        if not o:
-            out.append("{}")
-            return
-        inner = nl + INDENT
-        if _flat_types(tuple(map(type, o.values()))):
-            # scalars only, the common case: the C encoder writes the members ("{" ... "}"),
-            # keys converted as json.dumps converts them
+        if _flat_object(o):  # the C encoder writes the members, keys as json.dumps does
             out.append("{" + inner + _flat(inner)(o)[1:-1] + nl + "}")
             return
-        sep = "{" + inner
-        for k, v in o.items():
-            out.append(sep)
+        items, opening, closing = o.items(), "{", "}"
+    else:
+        if all(map(_flat_object, o)):  # a list of records (a simulation's events)
+            out.append(_records(o, nl, inner, inner + INDENT))
+            return
+        items, opening, closing = ((None, v) for v in o), "[", "]"
+    sep = opening + inner
+    for k, v in items:
+        out.append(sep)
+        if opening == "{":
             out.append(_string(k) if isinstance(k, str) else _key(k))
             out.append(": ")
-            if isinstance(v, _NESTED):
-                _write(v, out, inner)
-            else:
-                out.append(_scalar(v))
-            sep = "," + inner
-        out.append(nl + "}")
-    elif isinstance(o, (list, tuple)):
-        if not o:
-            out.append("[]")
-            return
-        inner = nl + INDENT
-        members, flat = inner + INDENT, _flat(inner + INDENT)  # of flat objects in the list
-        if all(type(v) is dict and v and _flat_types(tuple(map(type, v.values()))) for v in o):
-            out.append(_records(o, nl, inner, members))
-            return
-        opening, closing = "{" + members, inner + "}"
-        sep = "[" + inner
-        for v in o:
-            out.append(sep)
-            if type(v) is dict and v and _flat_types(tuple(map(type, v.values()))):
-                out.append(opening + flat(v)[1:-1] + closing)  # a record of a list
-            elif isinstance(v, _NESTED):
-                _write(v, out, inner)
-            else:
-                out.append(_scalar(v))
-            sep = "," + inner
-        out.append(nl + "]")
-    else:
-        out.append(_scalar(o))
+        _write(v, out, inner)
+        sep = "," + inner
+    out.append(nl + closing)
 
 
 def _records(o: list | tuple, nl: str, inner: str, members: str) -> str:
@@ -132,15 +119,7 @@ def _float(v: float) -> str:
 
 
 def _key(k: object) -> str:
-    """A key json.dumps turns into a string: a number, a boolean or null."""
-    if k is True:
-        return '"true"'
-    if k is False:
-        return '"false"'
-    if k is None:
-        return '"null"'
-    if isinstance(k, int):
-        return '"' + int.__repr__(k) + '"'
-    if isinstance(k, float):
-        return '"' + _float(k) + '"'
+    """A key json.dumps turns into a string: a number, a boolean or null, written as one."""
+    if k is None or isinstance(k, (int, float)):
+        return '"' + _scalar(k) + '"'
     raise TypeError(f"keys must be str, int, float, bool or None, not {type(k).__name__}")
