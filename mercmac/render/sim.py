@@ -73,7 +73,8 @@ def event_line(event) -> Line | None:
             return _at(t) + [("program ended: back in direct mode", "bold")]
         case ev.FastForwarded(t, t_to, passes, period, loop, shape, _, shift):
             kind = ("identical pass", "identical passes") if not shift else ("pass", "passes")
-            moved = f", each {shift:+,} counts further" if shift else ""
+            moved = (f", each {'+' if shift > 0 else '-'}{plural(abs(shift), 'count')} further"
+                     if shift else "")
             return _at(t) + [(f"fast-forward {plural(passes, *kind)} of {loop.label} "
                               f"({format_span(period)}{_emitted(shape)} each{moved}) "
                               f"to {clock(t_to)}", "magenta"), (_where(loop), "dim")]
