@@ -378,6 +378,8 @@ class Visit:
     position: int = 0  # the target (= position) here, when skey is not None
     delta: int | None = None  # position - the last visit's; None unless skeys were equal
     moved: tuple | None = None  # moved_shape of the pass that ended here
+    t: int = 0  # when the loop came round, us
+    fresh: bool = False  # the axis ran a profile planned since the visit before
 
 
 def same_pass(previous: Visit, now: Visit) -> bool:

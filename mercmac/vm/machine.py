@@ -717,9 +717,10 @@ class Machine:
     # ---------------------------------------------------------------- hardware events
     def _next_hardware(self, axis: bool = True) -> float:
         """When the hardware next does something by itself (with `axis`, the axis too)."""
-        t = min(self.inputs.next_change(), self.table_done)
         if axis:
-            t = min(t, self.axis.next_event())
+            t = min(self.inputs.next_change(), self.axis.next_event(), self.table_done)
+        else:
+            t = min(self.inputs.next_change(), self.table_done)
         if self.outputs.pulse_until > self.clock.now:
             t = min(t, self.outputs.pulse_until)
         if self.trigger.mode and axis:  # pulses of the running profile

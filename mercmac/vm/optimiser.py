@@ -177,10 +177,11 @@ class Optimiser:
     def _arrive(self, anchor: Anchor, own: int | None, remaining: float) -> None:
         """A loop came round: report a busy loop, skip identical passes (fastforward.py)."""
         previous = self.anchors.visits.get(anchor)
-        key = self._key(own)
+        fresh = self._fresh(previous)
+        key = self._key(own, previous, fresh)
         if previous is not None and self.waits == previous.waits and remaining >= BUSY_PASSES:
             self._busy_loop(anchor, key, previous)
-        visit = self._visit(key, previous)
+        visit = self._visit(key, previous, fresh)
         self.anchors.visits[anchor] = visit
         if previous is None or self.mode is FastForward.OFF:
             return
@@ -221,11 +222,13 @@ class Optimiser:
         """Have the machine jump, then arrive again: the jump's own event belongs to enclosing
         loops, not to the next pass."""
         self.machine._jump(jump)
-        key = self._key(jump.own)
+        now = self.machine.clock.now + jump.passes * jump.period  # where the last pass ends
+        key = self._key(jump.own, at=now)  # (moved on: as fresh as the pass it copies)
         skey, position = self._shift_key(key)
         self.anchors.visits[jump.anchor] = Visit(key, self.machine.wake, self.inputs, self.waits,
                                          self.log_base + len(self.log), visit.shape,
-                                         skey, position, visit.delta, visit.moved)
+                                         skey, position, visit.delta, visit.moved, now,
+                                         True)
 
     def _bound(self, axis: bool = True) -> float:
         """What a jump must stop before: the end of the run or the next hardware event (but
@@ -240,7 +243,7 @@ class Optimiser:
         if anchor.loop is Loop.RP or (key is not None and key == previous.key):
             self.machine._busy_loop(anchor)
 
-    def _visit(self, key: tuple | None, previous: Visit | None) -> Visit:
+    def _visit(self, key: tuple | None, previous: Visit | None, fresh: bool) -> Visit:
         """This arrival at an anchor, with what the pass since `previous` emitted."""
         if len(self.log) > LOG_LIMIT:  # passes this long are not compared
             self.log_base += len(self.log)
@@ -257,20 +260,31 @@ class Optimiser:
             moved = ff.moved_shape(self.log[previous.logged - self.log_base:],
                                    previous.wake, previous.position)
         return Visit(key, self.machine.wake, self.inputs, self.waits,
-                     self.log_base + len(self.log), pass_shape, skey, position, delta, moved)
+                     self.log_base + len(self.log), pass_shape, skey, position, delta, moved,
+                     self.machine.clock.now, fresh)
 
-    def _key(self, own: int | None) -> tuple | None:
-        """The machine's state key (Machine.STATE_KEY); while the axis moves, with its profile
-        relative to now and the target (Axis.relative), or None if it has none."""
-        m = self.machine
-        key = m._state_key(own)
-        axis = m.axis
+    def _fresh(self, previous: Visit | None) -> bool:
+        """Whether the axis runs a profile planned since the `previous` visit of the anchor."""
+        plan = self.machine.axis.plan
+        return plan is not None and (previous is None or plan.t > previous.t)
+
+    def _key(self, own: int | None, previous: Visit | None = None, fresh: bool = True,
+             at: int | None = None) -> tuple | None:
+        """The machine's state key (Machine.STATE_KEY) at `at` (now); while the axis moves, with
+        its profile relative to that time and the target (Axis.relative), or None if it has
+        none. Only a pass that planned its profile anew, after one that did too, can repeat
+        one: a profile that ran at the previous visit is not at the same phase now. (So a
+        polling loop that waits for a long move is spared the key at every pass.)"""
+        m, axis = self.machine, self.machine.axis
         if axis.segs or axis.stalled:
-            relative = axis.relative(m.clock.now)
+            if previous is not None and not (previous.fresh and fresh):
+                return None
+            relative = axis.relative(m.clock.now if at is None else at)
             if relative is None:
                 return None
-            return m.unshifted(key), relative, axis.target, axis.final, m.trigger.next_at
-        return key
+            return (m.unshifted(m._state_key(own)), relative, axis.target, axis.final,
+                    m.trigger.next_at)
+        return m._state_key(own)
 
     def _shift_key(self, key: tuple | None) -> tuple[tuple | None, int]:
         """The state key without the axis's position and target, and the target; (None, 0)
@@ -280,7 +294,7 @@ class Optimiser:
         if key is None:
             return None, 0
         axis = m.axis
-        trigger = m.trigger.relative(axis.target)
+        trigger = m.trigger.relative(axis.target) if m.trigger.mode else ()
         if axis.segs:  # (unshifted, relative, target, final)
             return (key[0], key[1], axis.final - axis.target, trigger), axis.target
         if axis.final != axis.target:
