@@ -207,10 +207,13 @@ class Recorder:
         stepped pass before the skip, listed up to the cap and counted (SPEC §5 `events`)."""
         end = skip.t if skip.anchor_t is None else skip.anchor_t
         template = self._pass_before(end, skip.period)
-        if template is None:  # longer than RECENT events: the skip stays a marker only
+        if template is not None:
+            block = Block(end, skip.period, skip.passes, skip.shift, template,
+                          sum(_size(entry) for entry in template))
+        elif skip.events is not None:  # a pass of more than RECENT events: counted only
+            block = Block(end, skip.period, skip.passes, skip.shift, (), sum(skip.events))
+        else:  # a rig's skip of such a pass: a marker only
             return
-        block = Block(end, skip.period, skip.passes, skip.shift, template,
-                      sum(_size(entry) for entry in template))
         self._recent.append(block)
         if not block.size:
             return
@@ -219,8 +222,8 @@ class Recorder:
             texts = ff.expand(skip.shape, skip.t, skip.period, skip.passes, ff.REPORT,
                               skip.position, skip.shift)
         listed = len(self.events)
-        self.events.extend(islice(unroll(template, skip.passes, skip.period, skip.shift,
-                                         0, 0, texts), max(CAP - listed, 0)))
+        self.events.extend(islice(unroll(block.template, skip.passes, skip.period,
+                                         skip.shift, 0, 0, texts), max(CAP - listed, 0)))
         self.dropped["events"] += _size(block) - (len(self.events) - listed)
 
     def _pass_before(self, t: int, period: int) -> tuple | None:

@@ -159,6 +159,9 @@ class FastForwarded:
     # when the loop came round: the skipped passes end there, k periods on (t, the next
     # command, may be a cycle later, and an arrival fall between); None: at t
     anchor_t: int | None = None
+    # each pass, counted: (events other than macro entries and exits, entries and exits), as
+    # the JSON `events` holds them (markers aside); None: not counted (a rig's skip)
+    events: tuple[int, int] | None = None
 
 
 @dataclass(frozen=True, slots=True)

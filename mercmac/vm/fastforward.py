@@ -380,6 +380,7 @@ class Visit:
     moved: tuple | None = None  # moved_shape of the pass that ended here
     t: int = 0  # when the loop came round, us
     fresh: bool = False  # the axis ran a profile planned since the visit before
+    flows: int = 0  # macro entries and exits so far, those of skipped passes too
 
 
 def same_pass(previous: Visit, now: Visit) -> bool:

@@ -784,7 +784,8 @@ class Machine:
                 self.on_report(r.t / 1000, r.text)
         self._emit(ev.FastForwarded(start, self.wake, jump.passes, jump.period,
                                     self._where_anchor(jump.anchor), jump.shape,
-                                    jump.position, jump.shift, self.clock.now))
+                                    jump.position, jump.shift, self.clock.now,
+                                    jump.counted))
 
     def _busy_loop(self, anchor: Anchor) -> None:
         """The optimiser found a long loop without a wait at `anchor`."""

@@ -26,7 +26,6 @@ INF = math.inf
 BUSY_PASSES = 1000  # a loop without waits this long (or endless) is a busy loop hazard
 LOG_LIMIT = 100_000  # effects kept for comparing passes; a longer pass is not skipped
 
-FLOW = (ev.MacroEntered, ev.MacroLeft, ev.Executed)  # control flow: repeats with the pass
 
 # reports that depend on the position or the motion: TP, TD, TT shift with it; TE and TV
 # do not at rest; TS shows the limit and reference switches; while moving, all but TT take
@@ -55,6 +54,7 @@ class Jump(NamedTuple):
     shape: tuple  # what each pass emitted (fastforward.shape or moved_shape)
     position: int  # where the first pass starts (a shifted jump)
     shift: int
+    counted: tuple[int, int]  # events of each pass: (others, macro entries and exits)
 
 
 class Anchors:
@@ -83,6 +83,7 @@ class Optimiser:
         self.horizon = INF  # the end of the run: it bounds a jump (skippable)
         self.waits = 0  # wait commands executed (a loop without any is a busy loop)
         self.inputs = 0  # input changes (a pass that sees one does not repeat)
+        self.flows = 0  # macro entries and exits, of skipped passes too (Jump.counted)
 
     # ------------------------------------------------------------ hooks: the machine says
     def running_to(self, until: int) -> None:
@@ -113,10 +114,13 @@ class Optimiser:
     def emitted(self, event: object) -> None:
         """An event the listeners heard: a pass's effects are all but its control flow (which
         repeats with it), and the inner skips that emitted something."""
-        if type(event) is ev.FastForwarded:
+        kind = type(event)
+        if kind is ev.FastForwarded:
             if event.shape:
                 self.log.append(event)
-        elif not isinstance(event, FLOW):
+        elif kind is ev.MacroEntered or kind is ev.MacroLeft:
+            self.flows += 1
+        elif kind is not ev.Executed:
             self.log.append(event)
 
     def move_requested(self, target: int) -> None:
@@ -194,7 +198,7 @@ class Optimiser:
         passes = ff.skippable(previous, visit, self._bound(), remaining)
         if passes > 0:
             self._jump(Jump(anchor, own, passes, visit.wake - previous.wake, visit.shape,
-                            visit.position, 0), visit)
+                            visit.position, 0, self._counted(previous, visit)), visit)
 
     def _skip_shifted(self, anchor: Anchor, own: int | None, previous: Visit, visit: Visit,
                       remaining: float) -> None:
@@ -208,7 +212,7 @@ class Optimiser:
             self.log.append(Note.UNSHIFTABLE)
         if passes > 0:
             self._jump(Jump(anchor, own, passes, period, visit.moved, visit.position,
-                            visit.delta), visit)
+                            visit.delta, self._counted(previous, visit)), visit)
 
     def boundaries(self) -> tuple:
         """What bounds a shifted skip here (fastforward.shifted_passes): the soft range, the
@@ -222,13 +226,26 @@ class Optimiser:
         """Have the machine jump, then arrive again: the jump's own event belongs to enclosing
         loops, not to the next pass."""
         self.machine._jump(jump)
+        self.flows += jump.passes * jump.counted[1]
         now = self.machine.clock.now + jump.passes * jump.period  # where the last pass ends
         key = self._key(jump.own, at=now)  # (moved on: as fresh as the pass it copies)
         skey, position = self._shift_key(key)
         self.anchors.visits[jump.anchor] = Visit(key, self.machine.wake, self.inputs, self.waits,
                                          self.log_base + len(self.log), visit.shape,
                                          skey, position, visit.delta, visit.moved, now,
-                                         True)
+                                         True, self.flows)
+
+    def _counted(self, previous: Visit, visit: Visit) -> tuple[int, int]:
+        """The events of the pass from `previous` to `visit`, as the recorder lists them:
+        those besides macro entries and exits (its effects, and those of the skips inside
+        it; not their markers), and its entries and exits (skipped ones too)."""
+        effects = 0
+        for e in self.log[previous.logged - self.log_base:visit.logged - self.log_base]:
+            if type(e) is ev.FastForwarded:
+                effects += e.passes * e.events[0] if e.events else 0
+            elif not isinstance(e, ff.NOTES):
+                effects += 1
+        return effects, visit.flows - previous.flows
 
     def _bound(self, axis: bool = True) -> float:
         """What a jump must stop before: the end of the run or the next hardware event (but
@@ -261,7 +278,7 @@ class Optimiser:
                                    previous.wake, previous.position)
         return Visit(key, self.machine.wake, self.inputs, self.waits,
                      self.log_base + len(self.log), pass_shape, skey, position, delta, moved,
-                     self.machine.clock.now, fresh)
+                     self.machine.clock.now, fresh, self.flows)
 
     def _fresh(self, previous: Visit | None) -> bool:
         """Whether the axis runs a profile planned since the `previous` visit of the anchor."""

@@ -73,6 +73,32 @@ def test_past_the_cap_the_events_of_skipped_passes_are_counted(name):
         len(plain["events"]) + plain.get("truncated", {}).get("events", 0)
 
 
+@pytest.mark.parametrize("name", LOOPS)
+def test_a_pass_too_long_to_copy_is_still_counted_exactly(name):
+    # with room to remember one event, no pass can be copied: the skip's own count
+    # (FastForwarded.events, from the optimiser) tells how many each skipped pass made
+    program = program_of(LOOPS[name])
+    with mock.patch.object(record_module, "CAP", 10**9):
+        plain = run(program, "off", 20_000)
+        with mock.patch.object(record_module, "RECENT", 1):
+            fast = run(program, "all", 20_000)
+    listed = stepped(fast["events"])
+    assert fast["truncated"]["events"] > 0  # counted, not listed
+    assert len(listed) + fast["truncated"]["events"] == len(plain["events"])
+
+
+@pytest.mark.parametrize("name", LOOPS)
+def test_the_skips_own_count_is_what_the_copies_are(name):
+    program = program_of(LOOPS[name])
+    machine, record = machine_for(program, fast_forward="all")
+    machine.power_on()
+    machine.run_until(20_000)
+    blocks = [b for b in record._recent if isinstance(b, record_module.Block)]
+    skips = [e for e in record.events if isinstance(e, ev.FastForwarded)]
+    assert blocks and len(blocks) == len(skips)
+    assert [b.size for b in blocks] == [sum(s.events) for s in skips]
+
+
 def test_the_json_of_the_cli_lists_the_passes_of_a_skip(tmp_path):
     (tmp_path / "jog.mcm").write_text(LOOPS["jog reporting its target"])
     result = CliRunner().invoke(main, ["sim", str(tmp_path / "jog.mcm"), "--until", "60s",
