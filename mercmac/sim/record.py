@@ -29,7 +29,10 @@ from mercmac.vm.trapezoid import Segment
 
 CAP = 10_000  # SPEC §5: reports, output changes and events beyond this are counted, not listed
 TIMELINE_CAP = 100_000  # timeline entries listed; the rest are counted (Recorder.unlisted)
-RECENT = 100_000  # events remembered to copy a skipped pass's (a longer pass is only counted)
+# events remembered to copy a skipped pass from: a pass of more could not be listed anyway
+# (two of them, stepped before the skip, filled the list), and is counted by the skip's own
+# count (FastForwarded.events); more live objects would slow every collection of the GC
+RECENT = CAP
 _MOVE_FIELDS = attrgetter(*(f.name for f in fields(ev.MoveStarted)))
 LONG_LOOP = 1000  # an RP repeating this often or more makes a macro a mode, not a step
 
