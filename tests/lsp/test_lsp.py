@@ -12,9 +12,9 @@ from mercmac.compiler import compile_source
 from mercmac.lsp.recheck import Rechecker, chunks
 from mercmac.source import Source
 
-pytest_lsp = pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
+pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
 from lsprotocol import types as t  # noqa: E402  (pytest-lsp brings it)
-from pytest_lsp import ClientServerConfig, LanguageClient  # noqa: E402
+from pytest_lsp import LanguageClient  # noqa: E402  (the client: tests/lsp/conftest.py)
 
 sys.path.insert(0, str(ROOT / "benchmarks"))
 from recheck_latency import full_program  # noqa: E402
@@ -40,12 +40,6 @@ macro run {
 }
 """
 
-
-@pytest_lsp.fixture(config=ClientServerConfig(server_command=[sys.executable, "-m", "mercmac", "lsp"]))
-async def client(lsp_client: LanguageClient):
-    await lsp_client.initialize_session(t.InitializeParams(capabilities=t.ClientCapabilities()))
-    yield
-    await lsp_client.shutdown_session()
 
 
 def _open(client: LanguageClient, text: str = TEXT) -> None:

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import random
 import re
-import sys
 
 import pytest
 from click.testing import CliRunner
@@ -23,9 +22,9 @@ from mercmac.compiler import compile_source
 from mercmac.lsp.recheck import Rechecker
 from mercmac.source import Source
 
-pytest_lsp = pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
+pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
 from lsprotocol import types as t  # noqa: E402  (pytest-lsp brings it)
-from pytest_lsp import ClientServerConfig, LanguageClient  # noqa: E402
+from pytest_lsp import LanguageClient  # noqa: E402  (the client: tests/lsp/conftest.py)
 
 URI = "file:///work/pages.mcm"
 
@@ -119,13 +118,6 @@ def _fmt(tmp_path, text: str) -> str:
     assert result.exit_code == 0, result.output
     return path.read_bytes().decode("utf-8")
 
-
-@pytest_lsp.fixture(config=ClientServerConfig(
-    server_command=[sys.executable, "-m", "mercmac", "lsp"]))
-async def client(lsp_client: LanguageClient):
-    await lsp_client.initialize_session(t.InitializeParams(capabilities=t.ClientCapabilities()))
-    yield
-    await lsp_client.shutdown_session()
 
 
 def _open(client: LanguageClient, text: str) -> None:

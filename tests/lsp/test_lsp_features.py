@@ -14,16 +14,15 @@
 from __future__ import annotations
 
 import asyncio
-import sys
 
 import pytest
 
 from helpers.compiling import compile_text
 
-pytest_lsp = pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
+pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
 from lsprotocol import types as t  # noqa: E402  (pytest-lsp brings it)
 from helpers.lsp_wire import INITIALIZE, Server, frame, notification, request  # noqa: E402
-from pytest_lsp import ClientServerConfig, LanguageClient  # noqa: E402
+from pytest_lsp import LanguageClient  # noqa: E402  (the client: tests/lsp/conftest.py)
 
 URI = "file:///nonexistent-lsp16/features.mcm"
 WAIT_S = 30.0
@@ -49,13 +48,6 @@ macro scan @12 { MR 5 }
 macro jog { call scan }
 """
 
-
-@pytest_lsp.fixture(config=ClientServerConfig(
-    server_command=[sys.executable, "-m", "mercmac", "lsp", "--stdio"]))
-async def client(lsp_client: LanguageClient):
-    await lsp_client.initialize_session(t.InitializeParams(capabilities=t.ClientCapabilities()))
-    yield
-    await lsp_client.shutdown_session()
 
 
 async def _open(client: LanguageClient, text: str) -> None:

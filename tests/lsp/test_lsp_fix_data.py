@@ -3,25 +3,18 @@
 was searched for in the statement, and found inside the keyword before it."""
 from __future__ import annotations
 
-import sys
 
 import pytest
 
-pytest_lsp = pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
+pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
 from lsprotocol import types as t  # noqa: E402  (pytest-lsp brings it)
-from pytest_lsp import ClientServerConfig, LanguageClient  # noqa: E402
+from pytest_lsp import LanguageClient  # noqa: E402  (the client: tests/lsp/conftest.py)
 
 from mercmac.compiler import checking, fixing  # noqa: E402
 from mercmac.source import Source  # noqa: E402
 
 URI = "file:///work/fix.mcm"
 
-
-@pytest_lsp.fixture(config=ClientServerConfig(server_command=[sys.executable, "-m", "mercmac", "lsp"]))
-async def client(lsp_client: LanguageClient):
-    await lsp_client.initialize_session(t.InitializeParams(capabilities=t.ClientCapabilities()))
-    yield
-    await lsp_client.shutdown_session()
 
 
 async def _actions(client: LanguageClient, text: str) -> list[t.CodeAction]:

@@ -17,21 +17,14 @@ import pytest
 
 from helpers.paths import ROOT
 
-pytest_lsp = pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
+pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
 from lsprotocol import types as t  # noqa: E402  (pytest-lsp brings it)
-from pytest_lsp import ClientServerConfig, LanguageClient  # noqa: E402
+from pytest_lsp import LanguageClient  # noqa: E402  (the client: tests/lsp/conftest.py)
 
 WAIT_S = 30.0
 RASTER = ROOT / "examples" / "rigs" / "raster"
 C863_ONLY = "macro tune { DP 200 }\nautostart { call tune }\n"  # DP: C-863 only (MM010)
 
-
-@pytest_lsp.fixture(config=ClientServerConfig(
-    server_command=[sys.executable, "-m", "mercmac", "lsp", "--stdio"]))
-async def client(lsp_client: LanguageClient):
-    await lsp_client.initialize_session(t.InitializeParams(capabilities=t.ClientCapabilities()))
-    yield
-    await lsp_client.shutdown_session()
 
 
 @pytest.fixture
