@@ -176,8 +176,7 @@ class PlotObserver:
                                     (skip.t_to, float(skip.position + moved))]
             self.trace.target.append((skip.t_to, self.trace.target[-1][1] + moved))
         # a move running across the skip's end runs on as the copy of the one before it
-        self.segments = tuple(seg._replace(t0=seg.t0 + span, x0=seg.x0 + moved)
-                              for seg in self.segments)
+        self.segments = tuple(seg.moved(span, moved) for seg in self.segments)
         self.sampled_to = skip.t_to
 
     def _copied(self, skip: ev.FastForwarded) -> bool:

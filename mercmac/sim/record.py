@@ -25,7 +25,6 @@ from mercmac.ops import TextEnum
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
 from mercmac.vm.opcodes import Opcode
-from mercmac.vm.trapezoid import Segment
 
 CAP = 10_000  # SPEC §5: reports, output changes and events beyond this are counted, not listed
 TIMELINE_CAP = 100_000  # timeline entries listed; the rest are counted (Recorder.unlisted)
@@ -89,7 +88,7 @@ def _moved(event, dt: int, dx: int, texts):
     if cls is ev.MoveStarted:
         t, kind, target, arrival, segments, where = _MOVE_FIELDS(event)
         return cls(t + dt, kind, target + dx, arrival + dt,
-                   tuple([Segment(s.t0 + dt, s.x0 + dx, s.v0, s.a, s.dt) for s in segments]),
+                   tuple([s.moved(dt, dx) for s in segments]),
                    where)
     if cls is ev.MoveEnded:
         return cls(event.t + dt, event.how, event.position + dx)

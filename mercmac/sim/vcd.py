@@ -130,8 +130,8 @@ class VcdObserver:
         dt, dx = (skip.passes - 1) * skip.period, (skip.passes - 1) * skip.shift
         for move in [m for m in self.moves if skip.t - skip.period <= m.t < skip.t]:
             changes.append((move.t + skip.period + dt, self.target, move.target + skip.shift + dx))
-            segments = tuple(seg._replace(t0=seg.t0 + skip.period + dt,
-                                     x0=seg.x0 + skip.shift + dx) for seg in move.segments)
+            segments = tuple(seg.moved(skip.period + dt, skip.shift + dx)
+                             for seg in move.segments)
             if segments:
                 end = min(int(segments[-1].t1), skip.t_to - 1)
                 changes += [(t, self.position, round(_position(segments, t)))

@@ -165,7 +165,7 @@ class Axis:
         if p.v == 0 and float(p.x).is_integer():
             self.segs = tuple(plan(p.t + dt, p.x + dx, 0.0, p.target + dx, p.speed, p.acc))
         else:
-            self.segs = tuple(Segment(s.t0 + dt, s.x0 + dx, s.v0, s.a, s.dt) for s in self.segs)
+            self.segs = tuple(s.moved(dt, dx) for s in self.segs)
         self._find_limit()
 
     def soft_range(self) -> tuple[int, int]:
@@ -227,7 +227,7 @@ class Axis:
         """DH: the present position becomes `value`, target shifted alike (SPEC §3)."""
         delta = value - self.position(t)
         self.shift += delta
-        self.segs = tuple(Segment(s.t0, s.x0 + delta, s.v0, s.a, s.dt) for s in self.segs)
+        self.segs = tuple(s.moved(0, delta) for s in self.segs)
         self.plan = None
         self.final += delta
         self.target = round(self.target + delta)

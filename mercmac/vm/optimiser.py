@@ -312,7 +312,7 @@ class Optimiser:
             return None, 0
         axis = m.axis
         trigger = m.trigger.relative(axis.target) if m.trigger.mode else ()
-        if axis.segs:  # (unshifted, relative, target, final)
+        if axis.segs:  # key: (unshifted, relative, target, final, next_at), from _key
             return (key[0], key[1], axis.final - axis.target, trigger), axis.target
         if axis.final != axis.target:
             return None, 0

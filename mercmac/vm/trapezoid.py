@@ -28,6 +28,10 @@ class Segment(NamedTuple):
     def t1(self) -> float:
         return self.t0 + self.dt
 
+    def moved(self, dt: float, dx: float) -> Segment:
+        """The same segment `dt` us later and `dx` counts further (DH, a skip's passes)."""
+        return Segment(self.t0 + dt, self.x0 + dx, self.v0, self.a, self.dt)
+
     def x(self, t: float) -> float:
         tau = min(max(t - self.t0, 0.0), self.dt)
         return self.x0 + (self.v0 + 0.5 * self.a * tau) * tau
