@@ -41,22 +41,28 @@ def rig(tmp_path) -> Path:
     return path
 
 
-async def _published(client: LanguageClient, uri: str) -> list[t.Diagnostic]:
-    """The next diagnostics published for `uri`."""
-    while True:
-        params = await asyncio.wait_for(
-            client.wait_for_notification(t.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS), WAIT_S)
-        if params.uri == uri:
-            return list(params.diagnostics)
+async def _published(client: LanguageClient, uri: str, before: object) -> list[t.Diagnostic]:
+    """The diagnostics published for `uri` after `before`, the list the client held when the
+    request went out. (Read from the client's store, not by waiting for the next
+    notification: one that arrives before such a wait has begun is missed, and the test
+    times out under load.)"""
+    loop = asyncio.get_running_loop()
+    deadline = loop.time() + WAIT_S
+    while (now := client.diagnostics.get(uri)) is before:
+        if loop.time() > deadline:
+            raise TimeoutError(f"no diagnostics published for {uri} in {WAIT_S:g} s")
+        await asyncio.sleep(0.02)
+    return list(now)
 
 
 async def _open(client: LanguageClient, path: Path, text: str | None = None,
                 language: str = "mcm") -> list[t.Diagnostic]:
     uri = path.as_uri()
+    before = client.diagnostics.get(uri)
     client.text_document_did_open(t.DidOpenTextDocumentParams(text_document=t.TextDocumentItem(
         uri=uri, language_id=language, version=1,
         text=path.read_text(encoding="utf-8") if text is None else text)))
-    return await _published(client, uri)
+    return await _published(client, uri, before)
 
 
 async def _eventually(client: LanguageClient, uri: str, codes: list[str]) -> list[str]:
@@ -89,10 +95,11 @@ async def test_rig_diagnostics_stand_in_the_rig_file(client: LanguageClient, rig
     assert found[0].range.start.line == line and found[0].source == "mercmac"
     # on change: a wire into an input that the box drives too (MR008) and the address fixed
     changed = text.replace('"y.out2 -> x.in2"', '"y.out2 -> x.in1"')
+    before = client.diagnostics.get(rig.as_uri())
     client.text_document_did_change(t.DidChangeTextDocumentParams(
         text_document=t.VersionedTextDocumentIdentifier(uri=rig.as_uri(), version=2),
         content_changes=[t.TextDocumentContentChangeWholeDocument(text=changed)]))
-    found = await _published(client, rig.as_uri())
+    found = await _published(client, rig.as_uri(), before)
     assert "MR008" in _codes(found) and "MR005" not in _codes(found)
     wire_line = changed.split("\n").index(next(x for x in changed.split("\n")
                                                if '"y.out2 -> x.in1"' in x))
@@ -173,9 +180,10 @@ async def test_a_saved_program_checks_its_rig_again(client: LanguageClient, rig:
     await _open(client, program)
     quiet = "target C-663\nautostart { WN 2, WF 2 }\n"  # never sets out1 (x.out1 -> y.in1)
     program.write_text(quiet, encoding="utf-8")
+    before = client.diagnostics.get(rig.as_uri())
     client.text_document_did_save(t.DidSaveTextDocumentParams(
         text_document=t.TextDocumentIdentifier(uri=program.as_uri()), text=quiet))
-    found = await _published(client, rig.as_uri())
+    found = await _published(client, rig.as_uri(), before)
     assert "MR009" in _codes(found)
 
 
