@@ -334,6 +334,8 @@ text at the position given.""", {
         "empty": "the rig names no controller: add a [controllers.NAME] table per controller",
         "name": "'{name}' is no controller name: write a letter or '_' then letters, digits "
                 "or '_' (x, stage_1)",
+        "rig-name": "'{name}' is no rig name: write a letter or '_' then letters, digits or "
+                    "'_' (raster, stage_1); the name is used in file names, never as a path",
         "unknown-controller": "{where} names '{name}', which is no controller of the "
                               "rig{hint}",
         "branch": "the joystick has no branch '{branch}': its branches are X, Y and Z "

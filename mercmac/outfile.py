@@ -77,13 +77,18 @@ def snapshot(path: str | os.PathLike, data: bytes) -> Snapshot:
     return Snapshot(len(data), os.stat(path).st_mtime_ns, hashlib.sha256(data).digest())
 
 
-def writable_target(path: str | os.PathLike, *, make_parents: bool = False) -> Path:
-    """The regular file that writing PATH will replace (symlinks followed), or OutputError.
+def writable_target(path: str | os.PathLike, *, make_parents: bool = False,
+                    follow: bool = True) -> Path:
+    """The regular file that writing PATH will replace (symlinks followed, or with
+    FOLLOW False refused), or OutputError.
 
     Call it before any work whose result would be lost if the file then could
     not be written (a flash writes its backup before touching the controller).
     """
     given = Path(path)
+    if not follow and given.is_symlink():
+        raise OutputError(f"cannot write {given}: it is a symbolic link, which is not followed here",
+                          hint="remove the link, or choose another folder")
     target = _followed(given)
     try:
         st = target.stat()
@@ -98,17 +103,32 @@ def writable_target(path: str | os.PathLike, *, make_parents: bool = False) -> P
         raise OutputError(f"cannot write {given}: it is read-only",
                           hint="make it writable (chmod u+w) if it is meant to change")
     folder = target.parent
-    if make_parents:
+    if not make_parents and not folder.is_dir():
+        missing = "is not a folder" if folder.exists() else "does not exist"
+        raise OutputError(f"cannot write {given}: {folder} {missing}")
+    writable_folder(folder, make=make_parents, doing=f"cannot write {given}")
+    return target
+
+
+def writable_folder(folder: str | os.PathLike, *, make: bool = False, doing: str = "") -> Path:
+    """FOLDER, where new files may be written (made with its parents when MAKE), or
+    OutputError starting with DOING. A missing folder is judged by the nearest one above it
+    that exists, where it would be made: read-only as a file is (_read_only), even for root,
+    who could otherwise make and fill folders in a 0555 one."""
+    folder = Path(folder)
+    doing = doing or f"cannot write in {folder}"
+    there = next((p for p in (folder, *folder.parents) if p.exists()), folder)
+    if not there.is_dir():
+        raise OutputError(f"{doing}: {there} is not a folder")
+    if _read_only(there, there.stat()):
+        raise OutputError(f"{doing}: no permission to write in {there}",
+                          hint="make it writable (chmod u+w) if it is meant to change")
+    if make:
         try:
             folder.mkdir(parents=True, exist_ok=True)
         except OSError as e:
             raise OutputError(f"cannot create the folder {folder}: {reason(e)}") from None
-    if not folder.is_dir():
-        missing = "is not a folder" if folder.exists() else "does not exist"
-        raise OutputError(f"cannot write {given}: {folder} {missing}")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise OutputError(f"cannot write {given}: no permission to write in {folder}")
-    return target
+    return folder
 
 
 def _followed(given: Path) -> Path:
@@ -116,10 +136,57 @@ def _followed(given: Path) -> Path:
     return Path(os.path.realpath(given)) if given.is_symlink() else given
 
 
-def _read_only(target: Path, st: os.stat_result) -> bool:
+def _read_only(path: Path, st: os.stat_result) -> bool:
     """As an editor sees it: no write permission bit at all (root may write anything, but a
-    0444 file says it is not meant to change), or not writable by this user."""
-    return not st.st_mode & 0o222 or not os.access(target, os.W_OK)
+    0444 file or a 0555 folder says it is not meant to change), or not writable by this user
+    (a folder: not writable and searchable)."""
+    access = os.W_OK | (os.X_OK if stat.S_ISDIR(st.st_mode) else 0)
+    return not st.st_mode & 0o222 or not os.access(path, access)
+
+
+def in_folder(folder: str | os.PathLike, name: str) -> Path:
+    """FOLDER/NAME, or OutputError when NAME is no plain file name (a separator, '.', '..',
+    a NUL): a name made from what a rig file, the history or a controller said must never
+    lead out of the folder it was meant for."""
+    seps = {os.sep, os.altsep} - {None}
+    if name in ("", ".", "..") or "\0" in name or any(sep in name for sep in seps):
+        raise OutputError(f"cannot write {name!r} in {folder}: it is no plain file name",
+                          hint="a name with a path separator or '..' would lead out of the folder")
+    return Path(folder) / name
+
+
+class Occupied(OutputError):
+    """Files that are there already and are not to be replaced (`fill` without REPLACE)."""
+
+    def __init__(self, paths: list[Path]):
+        self.paths = paths
+        super().__init__("there already: " + ", ".join(map(str, paths)))
+
+
+def fill(folder: str | os.PathLike, texts: dict[str, str], *, replace: bool = False) -> list[Path]:
+    """Write each of TEXTS (file name -> text) into FOLDER (made if missing), every target
+    checked before the first is written, so that a refusal writes nothing: a name that is no
+    plain file name, anything writable_target refuses, a symlink (never followed in a folder
+    mercmac fills, even with REPLACE: it could point anywhere), and unless REPLACE, a file
+    that is there already (Occupied, naming them all). Returns the files written."""
+    paths = [in_folder(folder, name) for name in texts]
+    writable_folder(folder, doing=f"cannot write in {folder}")
+    there = []
+    for path in paths:
+        if path.is_symlink():
+            raise OutputError(f"cannot write {path}: it is a symbolic link (to "
+                              f"{os.readlink(path)}); mercmac does not write through a link "
+                              f"in a folder it fills", hint="remove the link, or choose "
+                              "another folder")
+        if os.path.lexists(path):
+            writable_target(path)  # a folder, a device, a read-only file: refused
+            there.append(path)
+    if there and not replace:
+        raise Occupied(there)
+    writable_folder(folder, make=True)
+    for path, text in zip(paths, texts.values()):
+        write_text(path, text, follow=False)
+    return paths
 
 
 @contextlib.contextmanager
@@ -141,11 +208,11 @@ class Draft:
 @contextlib.contextmanager
 def drafting(path: str | os.PathLike, *, binary: bool = False, encoding: str = "utf-8",
              make_parents: bool = False, durable: bool = True,
-             expect: Snapshot | None = None) -> Iterator[Draft]:
+             expect: Snapshot | None = None, follow: bool = True) -> Iterator[Draft]:
     """`replacing`, with the last word left to the caller: a Draft whose file replaces PATH
     when the block ends normally, unless `keep` was set False; with EXPECT, only if PATH
-    still holds that."""
-    target = writable_target(path, make_parents=make_parents)
+    still holds that; FOLLOW as for writable_target."""
+    target = writable_target(path, make_parents=make_parents, follow=follow)
     with _terminable(path):
         try:
             import tempfile  # here: start-up of runs that write no file
@@ -183,18 +250,21 @@ def drafting(path: str | os.PathLike, *, binary: bool = False, encoding: str = "
 
 
 def write_bytes(path: str | os.PathLike, data: bytes, *, make_parents: bool = False,
-                expect: Snapshot | None = None) -> Path:
+                expect: Snapshot | None = None, follow: bool = True) -> Path:
     """Write DATA to PATH whole or not at all; returns the file written."""
-    with replacing(path, binary=True, make_parents=make_parents, expect=expect) as f:
+    with replacing(path, binary=True, make_parents=make_parents, expect=expect,
+                   follow=follow) as f:
         f.write(data)
     return _followed(Path(path))
 
 
 def write_text(path: str | os.PathLike, text: str, *, encoding: str = "utf-8",
-               make_parents: bool = False, expect: Snapshot | None = None) -> Path:
+               make_parents: bool = False, expect: Snapshot | None = None,
+               follow: bool = True) -> Path:
     """Write TEXT to PATH whole or not at all (UnicodeEncodeError before anything is
     written); returns the file written."""
-    return write_bytes(path, text.encode(encoding), make_parents=make_parents, expect=expect)
+    return write_bytes(path, text.encode(encoding), make_parents=make_parents, expect=expect,
+                       follow=follow)
 
 
 def _unchanged(target: Path, expect: Snapshot | None, path) -> None:
@@ -227,7 +297,7 @@ def _put(tmp: str, target: Path, path) -> None:
     """The complete temporary file becomes TARGET: renamed over it, or copied into it in
     place when TARGET has other names (hard links) that must see the new text too."""
     try:
-        links = target.stat().st_nlink
+        links = target.lstat().st_nlink  # a link put there since the check is replaced, not followed
     except FileNotFoundError:
         links = 1
     if links > 1:

@@ -148,7 +148,8 @@ def _guarded(work) -> None:
 @_from_file_or_port
 @click.option("-o", "--output", type=click.Path(dir_okay=False, allow_dash=True),
               callback=file_name, help="Write the source to this file instead of standard output.")
-@click.option("--force", is_flag=True, help="Write the source even over FILE itself.")
+@click.option("--force", is_flag=True, help="Write the source even over FILE itself; with "
+                                             "--rig, replace files DIR holds already.")
 @click.option("--rig", "rig_dir", type=click.Path(file_okay=False), callback=file_name,
               help="With --port: scan the chain and write a rig folder, DIR/NAME.rig.toml and "
                    "each controller's source (as `pull --rig`, decompiled).")
@@ -164,7 +165,7 @@ def decompile(file, port, address, baud, timeout, output, force, rig_dir) -> Non
     """
     def work() -> int:
         if rig_dir is not None:
-            return _decompile_rig(file, port, output, rig_dir, baud, timeout)
+            return _decompile_rig(file, port, output, rig_dir, baud, timeout, force)
         if not force:
             _not_the_input(file, output)  # refused before a port is read
         read = _read(file, port, address, baud, timeout)
@@ -179,7 +180,8 @@ def decompile(file, port, address, baud, timeout, output, force, rig_dir) -> Non
     _guarded(work)
 
 
-def _decompile_rig(file, port, output, rig_dir: str, baud: int, timeout: float) -> int:
+def _decompile_rig(file, port, output, rig_dir: str, baud: int, timeout: float,
+                   force: bool) -> int:
     """`decompile --port PORT --rig DIR`: `pull --rig` with decompiled sources (a program
     mercmac flashed comes back as its recorded source)."""
     from mercmac.cli.upload import pull_rig, rig_folder
@@ -198,7 +200,7 @@ def _decompile_rig(file, port, output, rig_dir: str, baud: int, timeout: float) 
                                     origin=f"{port}, address {m.address}")
         return (text if text.endswith("\n") or not text else text + "\n"), "decompiled"
 
-    return pull_rig(port, folder, baud, timeout, text_of)
+    return pull_rig(port, folder, baud, timeout, text_of, force=force)
 
 
 @click.command()

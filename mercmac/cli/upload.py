@@ -318,7 +318,8 @@ def _watch(port: str, address: int | None, finished: list):
 @click.option("--rig", "rig_dir", type=click.Path(file_okay=False), callback=file_name,
               help="Scan the chain and write a rig folder: DIR/NAME.rig.toml and a .mcm per "
                    "controller that answers (names from `mercmac history` when known).")
-def pull(port, port_option, output, address, baud, timeout, raw, rig_dir) -> None:
+@click.option("--force", is_flag=True, help="With --rig: replace files DIR holds already.")
+def pull(port, port_option, output, address, baud, timeout, raw, rig_dir, force) -> None:
     """Read every macro of the controller on PORT into a .mcm file.
 
     The file passes `mercmac check`, and `mercmac flash` puts back exactly
@@ -337,7 +338,10 @@ def pull(port, port_option, output, address, baud, timeout, raw, rig_dir) -> Non
             port = _port(port, port_option, "pull")
             return pull_rig(port, folder, baud, timeout,
                             lambda m: (m.pulled.text, "stored macros") if raw or not m.record
-                            else (m.record.source, "recorded source"))
+                            else (m.record.source, "recorded source"), force=force)
+        if force:
+            raise UsageError("--force goes with --rig: it replaces files the rig folder holds",
+                             hint="`pull -o FILE` replaces FILE without it")
         port = _port(port, port_option, "pull")
         to_file = output and output != "-"
         if to_file:
@@ -373,27 +377,26 @@ def rig_folder(rig_dir: str, *, output: str | None, address: int | None) -> Path
     """The folder `--rig DIR` writes to, refused before a controller is read (reading stops a
     running macro) when it cannot be made or written; UsageError for options that do not go
     with it."""
-    import os
+    from mercmac import outfile
 
     for name, used in (("-o", output is not None), ("--address", address is not None)):
         if used:
             raise UsageError(f"{name} does not go with --rig: the rig folder gets a file per "
                              f"controller that answers", hint="mercmac pull [PORT] --rig DIR")
     folder = Path(rig_dir).absolute()
-    there = next(p for p in (folder, *folder.parents) if p.exists())
-    if not there.is_dir() or not os.access(there, os.W_OK | os.X_OK):
-        why = "not writable" if there.is_dir() else "no folder"
-        raise UsageError(f"--rig {rig_dir}: {there} is {why}",
-                         hint="give a folder that can be written (it is made if missing)")
-    return folder
+    try:
+        return outfile.writable_folder(folder, doing=f"--rig {rig_dir}")  # made when written
+    except outfile.OutputError as e:
+        raise UsageError(e.message, hint="give a folder that can be written (it is made if "
+                                         "missing)") from None
 
 
-def pull_rig(port: str, folder: Path, baud: int, timeout: float, text_of) -> int:
+def pull_rig(port: str, folder: Path, baud: int, timeout: float, text_of, *,
+             force: bool = False) -> int:
     """Scan PORT, read every controller, write FOLDER/NAME.rig.toml and NAME.mcm for each;
     `text_of(member)`: a controller's .mcm text (stored macros, source, decompiled) and
-    what it is, for the table."""
-    import re
-
+    what it is, for the table. Every file is checked before the first is written; one that
+    is there already is replaced only with FORCE (SPEC §6), a symlink never."""
     from mercmac import outfile
     from mercmac.render import upload as view
     from mercmac.render.console import write_lines
@@ -402,20 +405,26 @@ def pull_rig(port: str, folder: Path, baud: int, timeout: float, text_of) -> int
     with view.AddressProgress(sys.stderr) as shown:
         members = rig.pull_rig(port, baud=baud, timing=_timing(timeout),
                                records=history_records(), on_address=shown)
-    name = rig.rig_name(members) or re.sub(r"\W+", "_", folder.name) or "rig"
+    name = rig.rig_name(members, folder)
+    made = [text_of(m) for m in members]
+    texts = {f"{m.name}.mcm": text for m, (text, _) in zip(members, made)}
+    texts[f"{name}.rig.toml"] = rig.rig_text(name, members, port)
     try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise UsageError(f"--rig {folder}: cannot make the folder: {outfile.reason(e)}") from None
-    how = []
-    for m in members:
-        text, made = text_of(m)
-        outfile.write_text(folder / f"{m.name}.mcm", text)
-        how.append(made)
+        outfile.fill(folder, texts, replace=force)
+    except outfile.Occupied as e:
+        raise UsageError(f"--rig {folder}: it holds {_listed(e.paths)} already; nothing was "
+                         f"written", hint="--force replaces them (your edits in them are lost)") \
+            from None
     rig_file = folder / f"{name}.rig.toml"
-    outfile.write_text(rig_file, rig.rig_text(name, members, port))
-    write_lines(view.pulled_rig_lines(members, port, rig_file, how), sys.stderr)
+    write_lines(view.pulled_rig_lines(members, port, rig_file, [how for _, how in made]),
+                sys.stderr)
     return EXIT_OK
+
+
+def _listed(paths: list[Path]) -> str:
+    """'x.mcm, y.mcm and r.rig.toml': the files a folder holds already, by name."""
+    names = [p.name for p in paths]
+    return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} and {names[-1]}"
 
 
 def _searching():

@@ -91,6 +91,12 @@ def _toml(text: str) -> tuple[dict, tuple[Span, str] | None]:
         return {}, (Span(1, 1), "arrays or tables nested too deeply to read")
 
 
+def is_name(text: str) -> bool:
+    """Whether TEXT is a rig's or a controller's name: a letter or '_', then letters, digits
+    or '_' (never a path: names become file names)."""
+    return bool(_NAME.match(text))
+
+
 class _Reader:
     """Reads the TOML table of one rig file into a Rig, reporting what it cannot take."""
 
@@ -111,9 +117,15 @@ class _Reader:
     # -- the parts --------------------------------------------------------------------------
 
     def _name(self, table: dict) -> str:
+        """The rig's `name`, a name as a controller's is: `flash --backup DIR/` and `pull
+        --rig` put it in file names, so '../x' or '/abs' would write outside the folder."""
         stem = os.path.basename(self.source.name)
         default = stem[:-len(SUFFIX)] if is_rig_path(stem) else stem
-        return self._typed(table, "name", str, "a string", default)
+        name = self._typed(table, "name", str, "a string", default)
+        if name is not default and not is_name(name):
+            self.report.add("rig-file", self.places.of("name"), "rig-name", name=name)
+            return default
+        return name
 
     def _controllers(self, tables: dict) -> tuple[Controller, ...]:
         if not tables and not self.report.has_errors:

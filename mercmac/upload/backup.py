@@ -72,6 +72,18 @@ def check(path: Path) -> Path:
         raise BackupError(e.message) from None
 
 
+def check_default() -> Path:
+    """The folder of the timestamped backups (default_path), or BackupError when it cannot
+    be written there: checked before the port opens, as a --backup path is (check), so that
+    an unwritable data folder is the same I/O problem, with nothing touched."""
+    folder = data_dir() / "backups"
+    try:
+        return outfile.writable_folder(folder, doing=f"cannot write backups in {folder}")
+    except outfile.OutputError as e:
+        raise BackupError(f"{e.message} (the per-user data folder; ${DATA_DIR_VARIABLE} "
+                          f"chooses another)") from None
+
+
 def save(text: str, path: Path) -> Path:
     """Write atomically and durably: a power cut leaves the old file or the whole new one.
 

@@ -134,7 +134,8 @@ def flash_file(port: str, path: str, *, address: int | None = 0, baud: int = DEF
     the program's is refused unless `force`. `address` None: 0 if anything answers there,
     else the only address that answers (survey.reach). Refused, FlashFailed, FlashInterrupted or
     PortError say what happened; backup.BackupError: `options.backup` cannot be written
-    (checked before the port is opened); OSError: the file cannot be read.
+    or the default backups' folder cannot be written (checked before the port is opened);
+    OSError: the file cannot be read.
     """
     watch = watch or Watch()
     options = options or FlashOptions()
@@ -144,6 +145,8 @@ def flash_file(port: str, path: str, *, address: int | None = 0, baud: int = DEF
         watch.compiled(compiled)
     if options.backup is not None:
         backup.check(options.backup)  # a device, FIFO or folder: refused before the port opens
+    elif not options.dry_run:
+        backup.check_default()  # an unwritable data folder too: the same I/O problem (exit 2)
     with open_controller(port, address or 0, baud=baud, timing=timing) as c:
         try:
             survey.reach(c, address, watch.searching)  # as pull_file finds it

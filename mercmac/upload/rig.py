@@ -17,7 +17,7 @@ from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING, Iterator
 
-from mercmac import mdtext
+from mercmac import mdtext, outfile
 from mercmac.upload import backup, flasher, history, protocol, survey
 from mercmac.upload.connect import Identity, identify, open_controller
 from mercmac.upload.controller import Controller, ControllerError
@@ -164,7 +164,9 @@ def flash_rig(port: str, path: str, *, only: list[str] | None = None, baud: int 
 
     Refused before the first write: the rig file or a program has errors, a name in `only`
     is not in the rig (NotChosen, exit 2), a controller does not answer or is not the rig's
-    model. FlashFailed: a write failed; the message says what each controller holds now.
+    model. backup.BackupError (exit 2, before the port opens): a backup cannot be written,
+    at --backup or in the data folder. FlashFailed: a write failed; the message says what
+    each controller holds now.
     `options.backup`: a folder (it exists, or a str ending in a separator) gets RIG-NAME.mcm
     per controller, anything else is a prefix: PREFIX-NAME.mcm (backup_paths).
     """
@@ -175,6 +177,8 @@ def flash_rig(port: str, path: str, *, only: list[str] | None = None, baud: int 
     for part, target in zip(result.parts, backup_paths(rig, options.backup)):
         if part.chosen and target is not None:
             part.backup_path = backup.check(target)  # refused before the port opens
+    if options.backup is None and not options.dry_run:
+        backup.check_default()  # the data folder too, as for a single flash (exit 2)
     chosen = [p for p in result.parts if p.chosen]
     with open_controller(port, chosen[0].member.address, baud=baud, timing=timing) as first:
         link = Link(first.transport)
@@ -236,9 +240,12 @@ def backup_paths(rig: "Rig", given: Path | str | None) -> list[Path | None]:
         return [None for _ in rig.controllers]
     text = str(given)  # a str keeps the separator at its end that Path drops
     if Path(text).is_dir() or text.endswith(("/", os.sep)):
-        return [Path(text) / f"{rig.name}-{c.name}.mcm" for c in rig.controllers]
-    stem = text[:-4] if text.lower().endswith(".mcm") else text
-    return [Path(f"{stem}-{c.name}.mcm") for c in rig.controllers]
+        folder, head = Path(text), f"{rig.name}-"
+    else:
+        stem = Path(text[:-4] if text.lower().endswith(".mcm") else text)
+        folder, head = stem.parent, f"{stem.name}-"
+    # the names are checked names (rig.load), and in_folder makes sure of it: never a path
+    return [outfile.in_folder(folder, f"{head}{c.name}.mcm") for c in rig.controllers]
 
 
 def _meet(link: Link, chosen: list[Part], result: RigResult, options: FlashOptions,
@@ -329,9 +336,6 @@ def _states(result: RigResult) -> str:
 
 # -- pulling a chain into a rig folder ---------------------------------------------------------
 
-RIG_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")  # a controller's name in a rig file
-
-
 @dataclass(frozen=True, slots=True)
 class Pulled:
     """One controller of a scanned chain: its name, what it holds, and the history record
@@ -368,21 +372,35 @@ def pull_rig(port: str, *, baud: int = DEFAULT_BAUD, timing: Timing = Timing(),
 def _named(read: list[tuple[int, survey.Pulled]], port: str, records: list) -> list[Pulled]:
     """Names from the history when a record of exactly these macros gives one, else aN;
     a name taken already (two rigs' `x`) falls back to aN too."""
+    from mercmac.rig.load import is_name
+
     out, taken = [], set()
     for address, pulled in read:
         record = history.recall(pulled.macros, records, port=port, address=address).record
         name = record.controller if record and record.controller else ""
-        if not RIG_NAME.match(name) or name in taken:
+        if not is_name(name) or name in taken:  # a history file may say anything
             name = f"a{address}"
         taken.add(name)
         out.append(Pulled(name, address, pulled, record))
     return out
 
 
-def rig_name(members: list[Pulled]) -> str | None:
-    """The rig's name as the history has it, when the records agree on one."""
+def rig_name(members: list[Pulled], folder: Path) -> str:
+    """The rig's name as the history has it, when the records agree on one that is a name
+    (a history file may say '../x'); else one made from the folder's name."""
+    from mercmac.rig.load import is_name
+
     names = {m.record.rig_name for m in members if m.record and m.record.rig_name}
-    return names.pop() if len(names) == 1 else None
+    if len(names) == 1 and is_name(said := names.pop()):
+        return said
+    return name_from(folder.name)
+
+
+def name_from(text: str) -> str:
+    """A rig name (rig.load.is_name) made from TEXT, a folder's name: 'my rig' -> 'my_rig',
+    '2026' -> '_2026', '' -> 'rig'."""
+    name = re.sub(r"[^A-Za-z0-9_]+", "_", text).strip("_") or "rig"
+    return f"_{name}" if name[0].isdigit() else name
 
 
 def rig_text(name: str, members: list[Pulled], port: str) -> str:

@@ -94,3 +94,26 @@ def test_the_readme_documents_the_keys_of_a_rig_file():
     toml = section.split("```toml\n", 1)[1].split("```", 1)[0]
     rig_file = parse_rig(Source(str(RASTER.parent / "readme.rig.toml"), toml))
     assert rig_file.report.items == [] and rig_file.rig.joystick == {"X": "x", "Y": "y"}
+
+
+@pytest.mark.parametrize("name", ["../../x", "/abs/x", "a/b", "..", "", "a b", "x\\y", "2x"])
+def test_a_rig_name_is_a_name_never_a_path(tmp_path, name):
+    """Issue 25 item 1: the name goes into file names (flash --backup DIR/, pull --rig), so
+    it is refused at the `name` key as a controller's name is, in `check` as in the reader."""
+    import json
+
+    from helpers.cli import cli
+
+    path = write_rig(tmp_path, f"# a rig\nname = {json.dumps(name)}\n" + WIRES + controllers())
+    assert read_rig(str(path)).rig is None
+    assert [f[:3] for f in _found(path)] == [("MR001", 2, 1)]
+    result = cli("check", path, "--format", "json")
+    assert result.exit_code == 1, result.output
+    (found,) = json.loads(result.output)["diagnostics"]
+    assert (found["code"], found["line"], found["column"]) == ("MR001", 2, 1)
+    assert "is no rig name" in found["message"]
+
+
+def test_a_rig_name_like_a_controller_name_is_taken(tmp_path):
+    path = write_rig(tmp_path, 'name = "stage_1"\n' + WIRES + controllers())
+    assert read_rig(str(path)).rig.name == "stage_1"

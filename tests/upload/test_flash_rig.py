@@ -223,3 +223,75 @@ def test_flash_then_pull_against_emulate_addresses_as_processes(rig, tmp_path, d
     assert [lines[a][-1][:4] for a in (0, 1)] == ["MD0,", "MD0,"]  # macro 0 last on each
     assert (out / "x.mcm").read_text() == (rig.parent / "x.mcm").read_text()
     assert (out / "raster.rig.toml").is_file()
+
+
+# -- issue 25: names are never paths; one rule for an unwritable backup folder ------------------
+
+def _nothing_sent(log: io.StringIO) -> bool:
+    return not re.search(r"^\s*[\d.]+ -> ", log.getvalue(), re.M)
+
+
+@pytest.mark.parametrize("name", ["../../escaped", "/abs/escaped"])
+def test_a_rig_named_like_a_path_writes_no_backup_outside_the_folder(rig, tmp_path, data_dir,
+                                                                     name):
+    """Item 1: `name = "../../x"` made `--backup DIR/` write DIR/../../x-x.mcm."""
+    rig.write_text(rig.read_text().replace('name = "raster"', f'name = "{name}"'))
+    saved = tmp_path / "deep" / "er" / "saved"
+    with chain() as (server, vcs, log):
+        result = cli("flash", server.path, rig, "--backup", f"{saved}/", *FAST)
+        assert md_counts(server, vcs) == [0, 0] and _nothing_sent(log)
+    assert result.exit_code == 1 and "is no rig name" in result.output
+    assert not list(tmp_path.rglob("*escaped*")) and not saved.exists()
+
+
+def test_backup_paths_never_lead_out_of_the_folder(rig, tmp_path):
+    """Defence in depth: a Rig built in the library with a path for a name is refused too."""
+    from dataclasses import replace
+
+    from mercmac.outfile import OutputError
+    from mercmac.rig.load import read_rig
+    from mercmac.upload.rig import backup_paths
+
+    good = read_rig(str(rig)).rig
+    assert backup_paths(good, f"{tmp_path}/b/") == [tmp_path / "b" / "raster-x.mcm",
+                                                   tmp_path / "b" / "raster-y.mcm"]
+    assert backup_paths(good, tmp_path / "pre.mcm") == [tmp_path / "pre-x.mcm",
+                                                       tmp_path / "pre-y.mcm"]
+    for name in ("../../escaped", "/abs/escaped", "a/b"):
+        with pytest.raises(OutputError, match="no plain file name"):
+            backup_paths(replace(good, name=name), f"{tmp_path}/b/")
+
+
+def _unwritable(data_dir: Path, how: str) -> None:
+    """The data folder as a file, or a read-only folder (refused by its mode, even as root)."""
+    if how == "file":
+        data_dir.write_text("not a folder")
+    else:
+        data_dir.mkdir()
+        data_dir.chmod(0o555)
+
+
+@pytest.mark.parametrize("how", ["file", "read-only"])
+def test_an_unwritable_data_folder_is_refused_before_the_port_as_backup_ro_is(rig, tmp_path,
+                                                                              data_dir, how):
+    """Item 15: it exited 1 once the port was open, where `--backup RO/` exits 2 before."""
+    _unwritable(data_dir, how)
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    try:
+        with chain() as (server, vcs, log):
+            default = cli("flash", server.path, rig, *FAST)
+            given = cli("flash", server.path, rig, "--backup", f"{ro}/", *FAST)
+            single = cli("flash", server.path, rig.parent / "x.mcm", *FAST)
+            assert md_counts(server, vcs) == [0, 0] and _nothing_sent(log)
+    finally:
+        ro.chmod(0o755)
+        if data_dir.is_dir():
+            data_dir.chmod(0o755)
+    for result in (default, given, single):
+        assert result.exit_code == 2, result.output
+        assert "Traceback" not in result.output
+    assert str(data_dir) in default.output and str(data_dir) in single.output
+    assert str(ro) in given.output
+    assert not list(tmp_path.rglob("*.json"))  # no history either

@@ -99,3 +99,114 @@ def test_pull_rig_as_a_process(rig, tmp_path, data_dir):
     assert done.returncode == 0, done.stderr
     assert "recorded source" in done.stderr
     assert (out / "y.mcm").read_text() == (rig.parent / "y.mcm").read_text()
+
+
+# -- issue 25: names from the history are never paths; DIR's files are not replaced silently -----
+
+def _poison(data_dir: Path, rig_name: str, controller: str) -> None:
+    """Every history record says the rig and the controller are called so."""
+    import json
+
+    for path in (data_dir / "history").glob("*.json"):
+        record = json.loads(path.read_text())
+        record.update(rig_name=rig_name, controller=controller)
+        path.write_text(json.dumps(record))
+
+
+@pytest.mark.parametrize("name", ["../../escaped", "/abs/escaped", "a/escaped", "..", "é"])
+def test_a_poisoned_history_never_leads_out_of_the_folder(rig, tmp_path, data_dir, name):
+    """Item 1: the rig's name in the history became DIR/NAME.rig.toml, '../../x' included."""
+    out = tmp_path / "deep" / "er" / "pulled"
+    with chain() as (server, vcs):
+        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        _poison(data_dir, name, name)
+        result = cli("pull", server.path, "--rig", out, *FAST)
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in out.iterdir()) == ["a0.mcm", "a1.mcm", "pulled.rig.toml"]
+    assert not list(tmp_path.rglob("*escaped*"))
+    assert cli("check", out / "pulled.rig.toml").exit_code == 0
+
+
+@pytest.mark.parametrize("folder,name", [("2026", "_2026"), ("my rig-1", "my_rig_1"),
+                                         ("été", "t"), ("--", "rig")])
+def test_a_rig_named_after_its_folder_checks_clean(tmp_path, data_dir, folder, name):
+    """The name made from the folder's is a name `check` takes (it made '2026' before)."""
+    out = tmp_path / folder
+    with chain(RAW) as (server, vcs):
+        result = cli("pull", server.path, "--rig", out, *FAST)
+    assert result.exit_code == 0, result.output
+    assert (out / f"{name}.rig.toml").is_file()
+    assert cli("check", out / f"{name}.rig.toml").exit_code == 0
+
+
+def _files(folder: Path) -> dict[str, str]:
+    return {p.name: p.read_text() for p in sorted(folder.iterdir()) if p.is_file()}
+
+
+@pytest.mark.parametrize("command", [("pull", "{port}"), ("decompile", "--port", "{port}")])
+def test_pulling_into_the_rigs_own_folder_needs_force(rig, data_dir, command):
+    """Item 2: it replaced raster.rig.toml (wires, box, comments gone) and an edited x.mcm."""
+    folder = rig.parent
+    (folder / "x.mcm").write_text((folder / "x.mcm").read_text() + "// edited, not flashed\n")
+    before = _files(folder)
+    with chain() as (server, vcs):
+        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        (folder / "x.mcm").write_text(before["x.mcm"] + "// edited again\n")
+        before = _files(folder)
+        args = [a.format(port=server.path) for a in command]
+        refused = cli(*args, "--rig", folder, *FAST)
+        assert _files(folder) == before
+        forced = cli(*args, "--rig", folder, "--force", *FAST)
+    assert refused.exit_code == 2, refused.output
+    said = refused.output
+    assert all(name in said for name in ("raster.rig.toml", "x.mcm", "y.mcm"))
+    assert "--force" in said and "nothing was written" in said
+    assert forced.exit_code == 0, forced.output
+    assert "wires = []" in (folder / "raster.rig.toml").read_text()
+
+
+def test_every_target_is_checked_before_the_first_is_written(tmp_path, data_dir):
+    """Item 2: `y.mcm -> /dev/null` left x.mcm written and no rig file."""
+    out = tmp_path / "bench"
+    out.mkdir()
+    (out / "a1.mcm").symlink_to("/dev/null")
+    with chain(RAW) as (server, vcs):
+        plain = cli("pull", server.path, "--rig", out, *FAST)
+        forced = cli("pull", server.path, "--rig", out, "--force", *FAST)
+    for result in (plain, forced):
+        assert result.exit_code == 2, result.output
+        assert "a1.mcm" in result.output and "symbolic link" in result.output
+        assert sorted(p.name for p in out.iterdir()) == ["a1.mcm"]
+    assert (out / "a1.mcm").is_symlink()
+
+
+def test_a_link_in_the_folder_is_never_followed_even_with_force(tmp_path, data_dir):
+    """Item 2: DIR/a0.mcm, a link to a file elsewhere, got that file overwritten."""
+    out, elsewhere = tmp_path / "bench", tmp_path / "precious.txt"
+    out.mkdir()
+    elsewhere.write_text("keep me\n")
+    (out / "a0.mcm").symlink_to(elsewhere)
+    with chain(RAW) as (server, vcs):
+        result = cli("pull", server.path, "--rig", out, "--force", *FAST)
+    assert result.exit_code == 2, result.output
+    assert "a0.mcm" in result.output and "symbolic link" in result.output
+    assert elsewhere.read_text() == "keep me\n" and (out / "a0.mcm").is_symlink()
+    assert sorted(p.name for p in out.iterdir()) == ["a0.mcm"]
+
+
+@pytest.mark.parametrize("inside", [False, True])
+def test_a_read_only_folder_is_refused_by_its_mode_even_as_root(tmp_path, data_dir, inside):
+    """Item 2: root ignores permission bits; a 0555 folder still says it is not to change.
+    Refused before any controller is read (reading stops a running macro): rig_folder."""
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    out = ro / "bench" if inside else ro
+    ro.chmod(0o555)
+    try:
+        with chain(RAW) as (server, vcs):
+            result = cli("pull", server.path, "--rig", out, *FAST)
+    finally:
+        ro.chmod(0o755)
+    assert result.exit_code == 2, result.output
+    assert str(ro) in result.output and "Traceback" not in result.output
+    assert list(ro.iterdir()) == []
