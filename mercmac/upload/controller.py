@@ -70,6 +70,18 @@ class Controller:
         report = self._await("%", protocol.is_status, timeout, size=SHORT_REPORT)
         return protocol.parse_status(report)
 
+    def answered_again(self, timeout: float) -> bool:
+        """Whether a second status report follows the one `probe` took within TIMEOUT: two
+        controllers set to this address both answered `%` (MS176E §3.2: each answers the code
+        of its own DIP-switch address, so two set alike talk at once)."""
+        try:
+            report = self.transport.read_report(timeout)
+        except ReadTimeout:
+            return False
+        except PortLost as e:
+            raise LinkLost(str(e), sent=protocol.STATUS_CHAR) from None
+        return protocol.is_status(report)
+
     def identify(self) -> Version:
         """VE: model and firmware (§3.3). Its first character also stops a running macro (§3.8.3)."""
         return protocol.parse_version(self._ask(mdtext.ve(), protocol.is_version))

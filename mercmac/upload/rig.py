@@ -355,7 +355,7 @@ def pull_rig(port: str, *, baud: int = DEFAULT_BAUD, timing: Timing = Timing(),
              records: list | None = None, on_address=None) -> list[Pulled]:
     """Every controller that answers a scan of PORT (addresses 0-15), read (which stops a
     running macro, MS176E §3.8.3), named as the history's `records` name it, else aN.
-    Refused when none answers."""
+    Refused when none answers, or two answer at one address (survey.Found.shared)."""
     with open_controller(port, 0, baud=baud, timing=timing) as first:
         t = first.transport
         t.timing = replace(timing, timeout=min(timing.timeout, survey.SEARCH_TIMEOUT))
@@ -365,8 +365,21 @@ def pull_rig(port: str, *, baud: int = DEFAULT_BAUD, timing: Timing = Timing(),
             raise Refused(f"no controller answers at addresses 0-15 on {port}",
                           hint=f"check power and cable, and that DIP switches 5-6 set the "
                                f"baud rate {baud}")
+        _one_at_each(found, port)
         read = [(f.address, survey.pull(Controller(t, f.address))) for f in found]
     return _named(read, port, records or [])
+
+
+def _one_at_each(found: list[survey.Found], port: str) -> None:
+    """Refused when two controllers answered at one address: what is read there mixes both
+    answers (MS176E §3.2), and a rig of it would merge two controllers into one."""
+    shared = [str(f.address) for f in found if f.shared]
+    if shared:
+        where = f"address {shared[0]}" if len(shared) == 1 else f"addresses {', '.join(shared)}"
+        raise Refused(f"two controllers answered at {where} on {port}: both are set to it, so "
+                      f"what is read there mixes them; nothing was written",
+                      hint="give each controller its own address (DIP switches 1-4, MS176E "
+                           "§3.1.3), then pull again")
 
 
 def _named(read: list[tuple[int, survey.Pulled]], port: str, records: list) -> list[Pulled]:

@@ -71,6 +71,7 @@ class Found:
     status: Status | None  # None when what came was not a status report (quoted in `note`)
     version: Version | None  # None when a running macro was left alone, or VE was garbled
     note: str = ""
+    shared: bool = False  # two controllers answered: both are set to this address
 
     @property
     def model(self) -> str:
@@ -84,7 +85,8 @@ def scan(transport: Transport, addresses=range(16), *, stop: bool = False,
     """Which addresses answer `%`; VE for those not running a macro (or all, with stop).
 
     An address whose answer is not a status report is listed with what came; a flood
-    of such replies ends the scan there, as the line carries nothing readable.
+    of such replies ends the scan there, as the line carries nothing readable. An address
+    where two status reports answer one `%` is `shared`: two controllers are set to it.
     `on_address(n)` is told each address before it is probed (a progress line).
     """
     found = []
@@ -96,10 +98,11 @@ def scan(transport: Transport, addresses=range(16), *, stop: bool = False,
         try:
             controller.select()  # 0x01 + address: the others deselect (MS176E §3.2)
             status = controller.probe()  # '%' does not stop a running macro (§6.3)
+            shared = controller.answered_again(transport.timing.settle)
             if status.macro_running and not stop:
-                found.append(Found(address, status, None, "macro running, left alone"))
+                found.append(_found(address, status, None, "macro running, left alone", shared))
                 continue
-            found.append(Found(address, status, controller.identify()))
+            found.append(_found(address, status, controller.identify(), "", shared))
         except LinkLost as e:
             raise UploadError(f"scan stopped at address {address}: {e}") from None
         except Flood as e:
@@ -112,6 +115,15 @@ def scan(transport: Transport, addresses=range(16), *, stop: bool = False,
             if status:
                 found.append(Found(address, status, None, f"VE: {e}"))
     return found
+
+
+def _found(address: int, status: Status, version: Version | None, note: str,
+           shared: bool) -> Found:
+    """A Found; a shared address says so first in its note."""
+    if shared:
+        note = "; ".join(filter(None, ["two controllers answered: both are set to this "
+                                       "address (DIP switches 1-4, MS176E §3.1.3)", note]))
+    return Found(address, status, version, note, shared)
 
 
 def find_address(transport: Transport,

@@ -210,3 +210,39 @@ def test_a_read_only_folder_is_refused_by_its_mode_even_as_root(tmp_path, data_d
     assert result.exit_code == 2, result.output
     assert str(ro) in result.output and "Traceback" not in result.output
     assert list(ro.iterdir()) == []
+
+
+# -- issue 25 item 15: two controllers at one address -------------------------------------------
+
+@contextmanager
+def shared_address(macros=RAW):
+    """Two controllers set to address 0 (and none at 1): the Chain refuses equal addresses
+    when it is built, so the second one's DIP switches are changed afterwards."""
+    with chain(macros) as (server, vcs):
+        server.call(lambda _c: setattr(vcs[1], "address", 0))
+        yield server, vcs
+
+
+def test_scan_says_that_two_controllers_answered_at_one_address(data_dir):
+    with shared_address() as (server, vcs):
+        result = cli("scan", server.path, "--stop", *FAST)
+    assert result.exit_code == 0, result.output
+    (row,) = [line for line in result.output.splitlines() if line.lstrip().startswith("0 ")]
+    assert "two controllers answered" in row
+    assert not any(line.lstrip().startswith("1 ") for line in result.output.splitlines())
+
+
+def test_scan_of_one_controller_per_address_says_nothing_of_it(data_dir):
+    with chain(RAW) as (server, vcs):
+        result = cli("scan", server.path, "--stop", *FAST)
+    assert result.exit_code == 0 and "two controllers" not in result.output
+
+
+@pytest.mark.parametrize("command", [("pull", "{port}"), ("decompile", "--port", "{port}")])
+def test_pull_rig_does_not_merge_two_controllers_at_one_address(tmp_path, data_dir, command):
+    out = tmp_path / "bench"
+    with shared_address() as (server, vcs):
+        result = cli(*[a.format(port=server.path) for a in command], "--rig", out, *FAST)
+    assert result.exit_code == 1, result.output
+    assert "two controllers answered at address 0" in result.output
+    assert "DIP switches" in result.output and not out.exists()
