@@ -14,7 +14,8 @@ error) the old bytes are written back; if even that fails, or the machine stops 
 the copy beside the file (`.mercmac-*.tmp`) holds the old text, and the error names it.
 
 A read-only file (no write permission bit, as an editor sees it, even for root) is
-refused. A caller that read the file first may pass what it read (`Snapshot`): the
+refused, and so is a file in a read-only folder (no write permission bit: root could
+write there, but the folder says it is not meant to change). A caller that read the file first may pass what it read (`Snapshot`): the
 file is then replaced only if it still holds exactly that (size, modification time and
 SHA-256), so that an edit another program saved meanwhile is not lost. The comparison
 and the replacement are two steps (no file system offers a compare-and-swap of a file):
@@ -24,7 +25,9 @@ Paths are taken deliberately: a symlink is followed (its target is rewritten,
 the link stays), an existing file keeps its permission bits, and anything that
 is not a regular file (a device such as /dev/null, a FIFO, a folder, a socket)
 is refused before anything is written, so a typo never turns /dev/sda into a
-regular file.
+regular file. In a folder mercmac fills with files it names itself (`fill`: `pull --rig`),
+a symlink is never followed but refused, and every file is checked before the first is
+written; a file already there is replaced only when the caller says so.
 """
 from __future__ import annotations
 
@@ -87,7 +90,7 @@ def writable_target(path: str | os.PathLike, *, make_parents: bool = False,
     """
     given = Path(path)
     if not follow and given.is_symlink():
-        raise OutputError(f"cannot write {given}: it is a symbolic link, which is not followed here",
+        raise OutputError(f"cannot write {given}: it is a symbolic link, not followed here",
                           hint="remove the link, or choose another folder")
     target = _followed(given)
     try:
@@ -297,7 +300,8 @@ def _put(tmp: str, target: Path, path) -> None:
     """The complete temporary file becomes TARGET: renamed over it, or copied into it in
     place when TARGET has other names (hard links) that must see the new text too."""
     try:
-        links = target.lstat().st_nlink  # a link put there since the check is replaced, not followed
+        # lstat: a symlink put there since the check is replaced itself, never written through
+        links = target.lstat().st_nlink
     except FileNotFoundError:
         links = 1
     if links > 1:
