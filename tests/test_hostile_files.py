@@ -283,3 +283,27 @@ def test_an_unwritable_folder_is_named(tmp_path, program_file):
     result = cli("build", program_file, "-o", tmp_path / "missing" / "out.txt")
     assert result.exit_code == 2
     assert "does not exist" in result.output and str(tmp_path / "missing") in result.output
+
+
+def test_a_read_only_folder_is_refused_by_its_mode_even_as_root(tmp_path, program_file):
+    """Issue 25: root writes into a 0555 folder, but the folder says it is not to change,
+    as a 0444 file does; and no folder is made in it either."""
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    try:
+        into = cli("build", program_file, "-o", ro / "out.txt")
+        below = cli("pull", "/dev/null", "-o", ro / "new" / "x.mcm")
+    finally:
+        ro.chmod(0o755)
+    for result in (into, below):
+        assert result.exit_code == 2, result.output
+        assert f"no permission to write in {ro}" in result.output
+    assert list(ro.iterdir()) == []
+
+
+def test_a_file_name_never_leads_out_of_its_folder(tmp_path):
+    for name in ("../x", "/abs", "a/b", "..", ".", "", "a\0b"):
+        with pytest.raises(outfile.OutputError, match="no plain file name"):
+            outfile.in_folder(tmp_path, name)
+    assert outfile.in_folder(tmp_path, "..x.mcm") == tmp_path / "..x.mcm"
