@@ -384,7 +384,8 @@ def _one_at_each(found: list[survey.Found], port: str) -> None:
 
 def _named(read: list[tuple[int, survey.Pulled]], port: str, records: list) -> list[Pulled]:
     """Names from the history when a record of exactly these macros gives one, else aN;
-    a name taken already (two rigs' `x`) falls back to aN too."""
+    a name taken already (two rigs' `x`) falls back to aN too, and an aN taken already
+    gets a '_' more: two controllers never share a file."""
     from mercmac.rig.load import is_name
 
     out, taken = [], set()
@@ -393,6 +394,8 @@ def _named(read: list[tuple[int, survey.Pulled]], port: str, records: list) -> l
         name = record.controller if record and record.controller else ""
         if not is_name(name) or name in taken:  # a history file may say anything
             name = f"a{address}"
+        while name in taken:  # aN named by the history for another address: one file each
+            name += "_"
         taken.add(name)
         out.append(Pulled(name, address, pulled, record))
     return out

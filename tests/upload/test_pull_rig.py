@@ -246,3 +246,21 @@ def test_pull_rig_does_not_merge_two_controllers_at_one_address(tmp_path, data_d
     assert result.exit_code == 1, result.output
     assert "two controllers answered at address 0" in result.output
     assert "DIP switches" in result.output and not out.exists()
+
+
+def test_a_history_name_like_another_address_does_not_merge_two_controllers(tmp_path, data_dir):
+    """The history names address 0 `a1`; address 1, never flashed, is a1 by its address:
+    each still gets its own file and table."""
+    from helpers.rig_files import X, write_rig
+
+    toml = ('[controllers.a1]\naddress = 0\nmodel = "C-663"\nprogram = "x.mcm"\n'
+            '[controllers.y]\naddress = 1\nmodel = "C-663"\nprogram = "y.mcm"\n')
+    rig = write_rig(tmp_path, toml)
+    out = tmp_path / "bench"
+    with chain(({}, RAW[1])) as (server, vcs):
+        flash_rig(server.path, str(rig), only=["a1"], timing=FAST_TIMING)
+        result = cli("pull", server.path, "--rig", out, *FAST)
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in out.iterdir()) == ["a1.mcm", "a1_.mcm", "r.rig.toml"]
+    assert (out / "a1.mcm").read_text() == X
+    assert cli("check", out / "r.rig.toml").exit_code == 0
