@@ -142,7 +142,8 @@ def for_rig(rig: Rig, *, firmware: str = "2.30", faults: Faults | None = None,
     folder = state_folder(state) if state else None
     made = {c.name: VirtualController(c.model, c.address, firmware=firmware,
                                       faults=replace(faults or Faults()),
-                                      state=folder / f"{c.name}.json" if folder else None)
+                                      state=outfile.in_folder(folder, f"{c.name}.json")
+                                      if folder else None)  # a name, never a path
             for c in rig.controllers}
     wires = [Wiring(made[w.source.controller], w.source.number,
                     made[w.target.controller], w.target.number) for w in rig.wires]

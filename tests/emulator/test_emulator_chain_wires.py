@@ -179,3 +179,21 @@ def test_an_input_two_outputs_drive_is_on_while_either_is():
 def test_rig_and_target_together_are_refused(tmp_path):
     result = cli("emulate", "--rig", rig_at(tmp_path), "--target", "C-663", catch=True)
     assert result.exit_code == 2 and "--target and --rig" in result.output
+
+
+def test_a_rig_state_file_is_named_in_its_folder_never_a_path(tmp_path):
+    """Issue 25 item 1, defence in depth: a Rig built in the library with a path for a
+    controller's name keeps no state outside the --state folder."""
+    from dataclasses import replace as changed
+
+    from mercmac.emulator.chain import for_rig
+    from mercmac.outfile import OutputError
+    from mercmac.rig.load import read_rig
+    from helpers.rig_files import RASTER
+
+    rig = read_rig(str(RASTER)).rig
+    hostile = changed(rig, controllers=(changed(rig.controllers[0], name="../../escaped"),
+                                        rig.controllers[1]))
+    with pytest.raises(OutputError, match="no plain file name"):
+        for_rig(hostile, state=tmp_path / "state")
+    assert not list(tmp_path.rglob("*escaped*"))
