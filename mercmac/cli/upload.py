@@ -472,7 +472,8 @@ def _check_output(path) -> None:
 
 def _unwritable(e: Exception) -> UsageError:
     """An output path that cannot be written (exit 2)."""
-    return UsageError(str(e), hint="give the path of a file to create or replace")
+    return UsageError(str(e), hint=getattr(e, "hint", None)
+                      or "give the path of a file to create or replace")
 
 
 @click.command()

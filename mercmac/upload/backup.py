@@ -21,6 +21,10 @@ DATA_DIR_VARIABLE = "MERCMAC_DATA_DIR"
 class BackupError(Exception):
     """The backup file cannot be written; nothing may be flashed then."""
 
+    def __init__(self, message: str, hint: str | None = None):
+        super().__init__(message)
+        self.hint = hint
+
 
 def to_mcm(macros: dict[int, str], version: Version, *, port: str, address: int,
            when: _dt.datetime | None = None) -> str:
@@ -80,8 +84,9 @@ def check_default() -> Path:
     try:
         return outfile.writable_folder(folder, doing=f"cannot write backups in {folder}")
     except outfile.OutputError as e:
-        raise BackupError(f"{e.message} (the per-user data folder; ${DATA_DIR_VARIABLE} "
-                          f"chooses another)") from None
+        raise BackupError(f"{e.message} (the per-user data folder)",
+                          hint=f"set ${DATA_DIR_VARIABLE} to a folder that can be written, "
+                               f"or give --backup PATH") from None
 
 
 def save(text: str, path: Path) -> Path:

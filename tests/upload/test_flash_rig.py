@@ -293,5 +293,6 @@ def test_an_unwritable_data_folder_is_refused_before_the_port_as_backup_ro_is(ri
         assert result.exit_code == 2, result.output
         assert "Traceback" not in result.output
     assert str(data_dir) in default.output and str(data_dir) in single.output
+    assert "$MERCMAC_DATA_DIR" in default.output and "--backup" in single.output  # the hint
     assert str(ro) in given.output
     assert not list(tmp_path.rglob("*.json"))  # no history either
