@@ -43,7 +43,7 @@ def test_a_bom_and_crlf_or_cr_line_ends_are_read(tmp_path, end):
 
 
 @pytest.mark.parametrize("toml,code,line,column,words", [
-    ("wires = [\n", "MR001", 2, 1, "not TOML"),
+    ("wires = [\n", "MR001", 2, 1, "not valid TOML"),
     (WIRES + controllers() + "adress = 3\n", "MR001", 10, 1, "unknown key 'adress'"),
     ("colour = 1\n" + WIRES + controllers(), "MR001", 1, 1, "unknown key 'colour'"),
     (WIRES + controllers().replace("address = 1\n", ""), "MR001", 6, 2, "needs 'address'"),

@@ -201,7 +201,12 @@ def test_a_fifo_or_device_as_scenario_is_refused_without_hanging(write, tmp_path
 
 
 def test_a_huge_scenario_is_refused(write):
-    path = write("# " + "x" * 2_000_000 + "\n", "s.toml")
+    """The cap of every TOML file mercmac reads (mercmac.tomlfile, issue 25 item 11)."""
+    from mercmac.source import MAX_BYTES
+
+    path = write(b"", "s.toml")
+    with open(path, "r+b") as f:
+        f.truncate(MAX_BYTES + 1)  # sparse: nothing is written, nothing must be read
     refused(sim(write(LED), "--scenario", path), "s.toml", "MB")
 
 
