@@ -8,6 +8,7 @@ import sys
 
 import pytest
 
+from helpers.python310 import without_tomllib
 from mercmac import tomlfile
 from mercmac.source import MAX_BYTES, SourceError
 
@@ -75,32 +76,14 @@ def test_only_a_regular_file_of_at_most_the_cap_is_read(tmp_path):
 
 def test_python_3_10_reads_with_tomli(monkeypatch):
     """No tomllib (Python 3.10): tomli, which pyproject.toml depends on there, reads the
-    file, and its errors are TomlErrors alike. (Where tomli is not installed, a stand-in
-    module of that name shows which one is used; on 3.10 the real one runs these tests.)"""
-    tomli = _stand_in_tomli()
-    monkeypatch.setitem(sys.modules, "tomli", tomli)
-    monkeypatch.setitem(sys.modules, "tomllib", None)  # `import tomllib` fails, as on 3.10
+    file, and its errors are TomlErrors alike (helpers.python310: where tomli is not
+    installed, a stand-in of that name shows which module is used)."""
+    tomli = without_tomllib(monkeypatch)
     assert tomlfile._tomllib() is tomli
     assert tomlfile.loads("a = 1\r") == {"a": 1}
     with pytest.raises(tomlfile.TomlError) as caught:
         tomlfile.loads("a = 1\nb = ?\n")
     assert (caught.value.line, caught.value.column) == (2, 5)
-
-
-def _stand_in_tomli():
-    """A module named tomli that parses as tomllib does (3.11's tomllib is tomli 2)."""
-    import importlib.util
-    import types
-
-    if importlib.util.find_spec("tomli") is not None:
-        import tomli
-
-        return tomli
-    import tomllib
-
-    module = types.ModuleType("tomli")
-    module.loads, module.TOMLDecodeError = tomllib.loads, tomllib.TOMLDecodeError
-    return module
 
 
 def test_settings_scenarios_and_rigs_read_through_it(monkeypatch, tmp_path):

@@ -2,8 +2,6 @@
 problem of the file itself at its line and column (issue 18)."""
 from __future__ import annotations
 
-import sys
-
 import pytest
 
 from mercmac.rig.load import is_rig_path, read_rig
@@ -125,10 +123,9 @@ def test_box_buttons_are_kept_once_each_in_order(tmp_path):
 def test_a_rig_reads_without_tomllib(monkeypatch, tmp_path):
     """Python 3.10 has no tomllib: the rig is read with tomli (issue 25 item 11), whose
     errors carry their place alike."""
-    from test_tomlfile import _stand_in_tomli
+    from helpers.python310 import without_tomllib
 
-    monkeypatch.setitem(sys.modules, "tomli", _stand_in_tomli())
-    monkeypatch.setitem(sys.modules, "tomllib", None)  # `import tomllib` fails, as on 3.10
+    without_tomllib(monkeypatch)
     assert read_rig(str(write_rig(tmp_path))).rig.name == "r"
     assert _found(write_rig(tmp_path, "wires = [\n"))[0][:3] == ("MR001", 2, 1)
 
