@@ -133,7 +133,7 @@ class _Reader:
         """The program's path, when it is a .mcm file in the rig's folder or below it (SPEC
         §6); else None, reported at the key without a word of the file (never opened: a
         rig from elsewhere must not make `check` print /etc/passwd or ~/.aws/credentials)."""
-        why = _outside(self.folder, program)
+        why = _why_refused(self.folder, program)
         if why is not None:
             self.report.add("rig-file", self.places.of(*path), "program", controller=name,
                             why=why)
@@ -252,7 +252,7 @@ def is_name(name: str) -> bool:
     return len(name) <= NAME_MAX and _NAME.match(name) is not None
 
 
-def _outside(folder: str, program: str) -> str | None:
+def _why_refused(folder: str, program: str) -> str | None:
     """Why `program` (as the rig file writes it) is no .mcm file in `folder` or below it;
     None when it is one. Links are followed by name only (realpath reads no file): a link
     that stays in the folder is taken, one that leads out of it is not."""
