@@ -354,7 +354,8 @@ the position given.""", {
 Each controller's `program` is a `.mcm` path relative to the rig file. The
 rig is checked, simulated and flashed as a whole, so a program that is missing
 or unreadable stops all of it; the message says why the file could not be
-read.""", {"": "the program of {controller} cannot be read: {why}"}),
+read. Like any file that cannot be read, it makes every command exit 2 (I/O),
+`check` too.""", {"": "the program of {controller} cannot be read: {why}"}),
     Rule("MR003", "rig-wire", _E, "a wire that is not OUTPUT -> INPUT", """\
 A wire joins an output line of one controller to an input line of another:
 `"x.out1 -> y.in1"` (or `→`). A Mercury has 4 digital outputs and 4 inputs
