@@ -10,11 +10,12 @@ In one folder mercmac.toml wins over pyproject.toml; a pyproject.toml without a
 `[tool.mercmac]` table is passed over (as ruff does). Command-line options override
 these settings key by key.
 
-A settings file is UTF-8 TOML. A leading UTF-8 byte-order mark is read past, as ruff and
-Cargo read one (Windows editors write it; TOML 1.0 does not forbid it, tomllib alone
-refuses it). Only a regular file is read, and at most mercmac.source.MAX_BYTES of it: a
-FIFO or a link to /dev/zero is named, not waited on (issue 20). Whatever is wrong with
-a settings file stops `check` with a message naming the file (exit 2).
+A settings file is UTF-8 TOML, read by mercmac.tomlfile as scenarios and rigs are: a
+leading UTF-8 byte-order mark is read past, as ruff and Cargo read one (Windows editors
+write it; TOML 1.0 does not forbid it, tomllib alone refuses it). Only a regular file is
+read, and at most mercmac.source.MAX_BYTES of it: a FIFO or a link to /dev/zero is named,
+not waited on (issue 20). Whatever is wrong with a settings file stops `check` with a
+message naming the file (exit 2).
 """
 from __future__ import annotations
 
@@ -115,39 +116,27 @@ def _toml_type(value) -> str:
 
 
 def _read(path: str) -> str:
-    """A settings file's text: a regular file, capped (mercmac.source.read_bytes), UTF-8."""
+    """A settings file's text (mercmac.tomlfile: a regular file, capped, UTF-8)."""
+    from mercmac import tomlfile
     from mercmac.outfile import reason
-    from mercmac.source import read_bytes
 
     try:
-        data = read_bytes(path)
+        return tomlfile.read_text(path)
     except OSError as e:
         raise SettingsError(f"cannot read the settings in {path}: {reason(e)}") from None
-    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        raise SettingsError(f"cannot read the settings in {path}: it starts with a "
-                            "UTF-16 byte-order mark, and TOML files are UTF-8",
-                            hint="save it as UTF-8")
-    try:
-        return data.decode("utf-8-sig")  # a leading UTF-8 BOM is read past (module docstring)
-    except UnicodeDecodeError as e:
-        line = data[:e.start].count(b"\n") + 1
-        raise SettingsError(f"cannot read the settings in {path}: byte "
-                            f"0x{data[e.start]:02X} at line {line} is not UTF-8, and TOML files "
-                            "are UTF-8", hint="save it as UTF-8") from None
+    except tomlfile.TomlError as e:
+        raise SettingsError(f"cannot read the settings in {path}: {e.why}",
+                            hint="save it as UTF-8") from None
 
 
 def _load(path: str, text: str) -> dict:
+    from mercmac import tomlfile
+
     try:
-        import tomllib
-    except ImportError:  # Python 3.10
-        import tomli as tomllib
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise SettingsError(f"{path} is not valid TOML: {e}") from None
-    except RecursionError:  # tomllib reads nested arrays and tables by recursion
-        raise SettingsError(f"{path} is not valid settings: its arrays or tables are "
-                            "nested too deeply to read") from None
+        return tomlfile.loads(text)
+    except tomlfile.TomlError as e:
+        at = f" (at line {e.line}, column {e.column})" if e.line else ""
+        raise SettingsError(f"{path}: {e.why}{at}") from None
 
 
 def _parse(path: str, table: dict, where: str = "") -> Settings:

@@ -325,28 +325,40 @@ A rig file (`NAME.rig.toml`) is UTF-8 TOML with the keys the README's "Rigs"
 section lists: `name`, `box`, `box_buttons`, `wires`, a `[joystick]` table and
 one `[controllers.NAME]` table per controller with `address`, `model` and
 `program`. A key mercmac does not know is refused rather than passed over, so
-a misspelled `adress` cannot silently leave a controller at a default. Fix the
-text at the position given.""", {
-        "toml": "not TOML: {error}",
+a misspelled `adress` cannot silently leave a controller at a default. A
+controller's name is at most 64 ASCII letters, digits and '_'. A `program` is a
+`.mcm` file in the rig file's folder or below it (a link that leads out of it
+is refused too): any other path is refused without opening the file, so a rig
+from elsewhere cannot make `check` show another file's lines. Fix the text at
+the position given.""", {
+        "toml": "{error}",
         "unknown": "unknown key '{key}' {where}; the keys are {keys}",
         "missing": "{where} needs '{key}'",
         "type": "'{key}' {where} must be {expects}",
         "empty": "the rig names no controller: add a [controllers.NAME] table per controller",
         "name": "'{name}' is no controller name: write a letter or '_' then letters, digits "
-                "or '_' (x, stage_1)",
+                "or '_' (x, stage_1), at most {longest} characters",
+        "program": "the program of {controller} must be a .mcm file in the rig file's folder "
+                   "or below it: {why}",
         "rig-name": "'{name}' is no rig name: write a letter or '_' then letters, digits or "
-                    "'_' (raster, stage_1); the name is used in file names, never as a path",
+                    "'_' (raster, stage_1), at most {longest} characters; the name is used in file "
+                    "names, never as a path",
         "unknown-controller": "{where} names '{name}', which is no controller of the "
                               "rig{hint}",
         "branch": "the joystick has no branch '{branch}': its branches are X, Y and Z "
                   "(MS176E §3.6)",
         "button": "the C-170.PB box has no button {button}: its buttons are 1-4 on inputs 1-4",
+        "button-twice": "button {button} is listed twice in box_buttons",
+        "buttons-without-box": "box_buttons lists the buttons of the C-170.PB box, and the "
+                               "rig has no box: add box = \"NAME\" (the box's controller) "
+                               "or remove box_buttons",
     }),
     Rule("MR002", "rig-program", _E, "a controller's program cannot be read", """\
 Each controller's `program` is a `.mcm` path relative to the rig file. The
 rig is checked, simulated and flashed as a whole, so a program that is missing
 or unreadable stops all of it; the message says why the file could not be
-read.""", {"": "the program of {controller} cannot be read: {why}"}),
+read. Like any file that cannot be read, it makes every command exit 2 (I/O),
+`check` too.""", {"": "the program of {controller} cannot be read: {why}"}),
     Rule("MR003", "rig-wire", _E, "a wire that is not OUTPUT -> INPUT", """\
 A wire joins an output line of one controller to an input line of another:
 `"x.out1 -> y.in1"` (or `→`). A Mercury has 4 digital outputs and 4 inputs

@@ -128,9 +128,29 @@ def test_a_utf8_byte_order_mark_is_read_past(tmp_path):
     '\ufeffselect = ["MM012"]\n'.encode("utf-16-le"),
     '\ufeffselect = ["MM012"]\n'.encode("utf-16-be"),
 ])
-def test_a_utf16_file_is_named_as_such(tmp_path, data):
+def test_a_utf16_file_with_its_mark_is_read(tmp_path, data):
+    """Issue 25 item 11: settings, scenarios and rigs are read by one reader
+    (mercmac.tomlfile), and a scenario in Notepad's "Unicode" was always read."""
     (tmp_path / "mercmac.toml").write_bytes(data)
-    _refused(_check(), "mercmac.toml", "UTF-16 byte-order mark")
+    assert _rules(_check()) == ["undefined-macro"]
+
+
+def test_utf16_that_does_not_read_is_named_as_such(tmp_path):
+    (tmp_path / "mercmac.toml").write_bytes(b"\xff\xfe" + "select = 1".encode("utf-16-le")
+                                            + b"\x00\xd8")  # a lone surrogate
+    _refused(_check(), "mercmac.toml", "UTF-16 byte-order mark", "TOML files are UTF-8")
+
+
+def test_lone_cr_line_ends_are_read(tmp_path):
+    """Issue 25 item 11: settings are read by the one TOML reader (mercmac.tomlfile), which
+    reads LF, CRLF and lone CR line ends alike, as every other file (SPEC §5)."""
+    (tmp_path / "mercmac.toml").write_bytes(b'target = "C-863"\rselect = ["MM012"]\r')
+    assert _rules(_check()) == ["undefined-macro"]
+
+
+def test_a_number_of_thousands_of_digits_is_said(tmp_path):
+    (tmp_path / "mercmac.toml").write_text("a = 1\nb = " + "9" * 5000 + "\n", encoding="utf-8")
+    _refused(_check(), "mercmac.toml", "too many digits", "line 2, column 5")
 
 
 def test_a_byte_that_is_not_utf8_is_located(tmp_path):

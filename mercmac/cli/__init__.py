@@ -144,6 +144,7 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
                 continue
             results += [findings.compilation for findings in checked]
             found += [d for findings in checked for d in findings.diagnostics]
+            unreadable += _programs_unread(f, checked)
         if not results:
             return EXIT_USAGE
         if fixes is not None:
@@ -219,6 +220,18 @@ def _check_rig(path: str, chosen, fixes) -> list:
     return check_rig_path(path, chosen)
 
 
+def _programs_unread(path: str, checked: list) -> int:
+    """How many programs of the rig at `path` could not be read (shown as MR002): they make
+    the exit code 2, as any unreadable file does (mercmac.rig.checks.unreadable_programs)."""
+    from mercmac.rig import is_rig_path
+
+    if not is_rig_path(path):
+        return 0
+    from mercmac.rig.checks import unreadable_programs
+
+    return unreadable_programs(checked)
+
+
 def _show(found, results, fmt: str, statistics: bool, limit: int | None) -> None:
     """Write the diagnostics (or their counts) in the chosen format."""
     from mercmac.render import report as render
@@ -250,12 +263,16 @@ def build(file: str, output: str | None, target: str | None) -> None:
     """Print the MD lines that go to the controller: slot order, macro 0 last.
 
     Refuses (exit 1, diagnostics on standard error) when the file has errors;
-    warnings are shown on standard error and the build goes on.
+    warnings are shown on standard error and the build goes on. FILE is one program:
+    a rig file is refused (exit 2), naming its programs to build one by one.
     """
     def work() -> int:
         from mercmac.compiler import compile_file
         from mercmac.render import report as render
+        from mercmac.rig import is_rig_path
 
+        if is_rig_path(file):
+            _refuse_rig_build(file)
         result = compile_file(file, target=target)
         if render.write_errors(result):
             return EXIT_FAILED
@@ -270,6 +287,39 @@ def build(file: str, output: str | None, target: str | None) -> None:
         return EXIT_OK
 
     run_guarded(work)
+
+
+def _refuse_rig_build(path: str) -> None:
+    """UsageError: `build` writes one controller's MD lines to one output, and a rig has a
+    program per controller (`flash RIG` writes them all); the hint names the programs."""
+    import shlex
+
+    from mercmac.cli.common import UsageError
+    from mercmac.render.report import printable
+    from mercmac.rig.load import read_rig
+
+    try:
+        rig = read_rig(path).rig
+    except OSError:  # named, not read: the refusal does not depend on the file
+        rig = None
+    builds = [f"mercmac build {shlex.quote(_shorter(c.program))}" for c in rig.controllers] \
+        if rig is not None else []
+    hint = (f"build its programs one by one: {'; '.join(builds)}" if builds
+            else f"`mercmac check {path}` says what is wrong with the rig")
+    raise UsageError(f"build takes one program (a .mcm file), and {printable(path)} is a rig "
+                     "file", hint=printable(hint))
+
+
+def _shorter(path: str) -> str:
+    """PATH relative to the working folder when that is shorter (a rig's programs are
+    absolute paths)."""
+    import os
+
+    try:
+        relative = os.path.relpath(path)
+    except ValueError:  # another drive (Windows)
+        return path
+    return relative if len(relative) < len(path) else path
 
 
 @main.command()

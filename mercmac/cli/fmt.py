@@ -84,7 +84,9 @@ def _one(path: str, *, check: bool, diff: bool) -> bool | None:
     from mercmac.fmt import FormatError, format_text, load
     from mercmac.source import read_bytes
 
-    name = "<stdin>" if path == "-" else path
+    from mercmac.render.report import printable
+
+    name = "<stdin>" if path == "-" else printable(path)
     try:
         data = read_bytes(path)
         before = None if path == "-" else outfile.snapshot(path, data)
@@ -98,6 +100,7 @@ def _one(path: str, *, check: bool, diff: bool) -> bool | None:
             say(f"would reformat {name}")
         elif formatted != text and not check:
             outfile.write_bytes(path, encoding.write(formatted), expect=before)
+            say(f"reformatted {name}")  # each file written is named (a rig's programs too)
         return formatted != text
     except FormatError as e:
         say(f"cannot format {name}: {e.message}", e.hint)

@@ -46,6 +46,13 @@ def check_rig_path(path: str, chosen: checking.Options = checking.Options()) -> 
     return check_rig(rig_file, checking.choice_for(path, chosen))
 
 
+def unreadable_programs(findings: list[Findings]) -> int:
+    """How many programs of a rig could not be read (MR002 among `findings`): an I/O
+    problem, exit 2 in every command that takes the rig, as an unreadable file is; a
+    `program` path the rig may not name is the rig's own error (MR001, exit 1)."""
+    return sum(d.rule.name == "rig-program" for f in findings for d in f.diagnostics)
+
+
 def check_rig(rig_file: RigFile, choice: Choice,
               read: Callable[[str], Source] = read_source) -> list[Findings]:
     """The findings of the rig file and of each of its programs under `choice` (its

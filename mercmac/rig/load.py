@@ -1,7 +1,7 @@
 """Reading a rig file: NAME.rig.toml -> a Rig, or the diagnostics of what is wrong with the
 file itself (MR001 rig-file, MR003 rig-wire), each at its line and column (issue 18).
 
-The file is read as the settings files are (mercmac.config): a regular file, at most
+The file is read as settings and scenarios are (mercmac.tomlfile): a regular file, at most
 mercmac.source.MAX_BYTES, UTF-8 with an optional byte-order mark. A key mercmac does not
 know is an error, not passed over: a misspelled `adress` must not leave a default.
 """
@@ -16,7 +16,7 @@ from mercmac.diagnostics import Report
 from mercmac.rig import SUFFIX, is_rig_path  # noqa: F401 (is_rig_path: read here too)
 from mercmac.rig.locate import Places, locate
 from mercmac.rig.model import Controller, Line, LineKind, Rig, Wire
-from mercmac.source import Source, Span, read_bytes, split_lines, to_lf
+from mercmac.source import Source, Span, read_bytes
 from mercmac.suggest import suggest
 
 TOP_KEYS = ("name", "box", "box_buttons", "wires", "joystick", "controllers")
@@ -24,8 +24,12 @@ CONTROLLER_KEYS = ("address", "model", "program")
 BRANCHES = ("X", "Y", "Z")  # C-819.20 (X, Y through the Y-cable) and C-819.30 (X, Y, Z), §3.6
 BUTTONS = (1, 2, 3, 4)  # the C-170.PB box: button n on input n (MS176E §4.5.1)
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
-_WIRE = re.compile(r"\s*(\w+)\.(in|out)(\d+)\s*(?:->|→)\s*(\w+)\.(in|out)(\d+)\s*\Z")
-_TOML_AT = re.compile(r"\(at (?:line (\d+), column (\d+)|end of document)\)")
+# The longest name of a controller or a rig: names become parts of file names (backups,
+# pulled programs), and a file name of 255 bytes or more is refused by the file system.
+NAME_MAX = 64
+# ASCII only (re.ASCII): `\d` and `\w` would take `x.out١` (an Arabic-Indic one) too
+_WIRE = re.compile(r"\s*(\w+)\.(in|out)(\d+)\s*(?:->|→)\s*(\w+)\.(in|out)(\d+)\s*\Z", re.ASCII)
+PROGRAM_SUFFIX = ".mcm"  # in any case, as mercmac.files takes `PROG.MCM`
 
 
 class RigFile(NamedTuple):
@@ -40,21 +44,25 @@ class RigFile(NamedTuple):
 
 def read_rig(path: str) -> RigFile:
     """The rig in the file at `path`; OSError when it cannot be read at all."""
+    from mercmac import tomlfile
+
     data = read_bytes(path)
     try:
-        text = data.decode("utf-8-sig")  # a leading BOM is read past, as config.py does
-    except UnicodeDecodeError as e:
+        text = tomlfile.decode(data)
+    except tomlfile.TomlError as e:
         source = Source(path, data.decode("utf-8", errors="replace"))
-        return _refused(source, _line_of(data, e.start), "not UTF-8 (TOML files are UTF-8): "
-                        f"byte 0x{data[e.start]:02X}")
+        return _refused(source, Span(e.line or 1, e.column or 1), e.why)
     return parse_rig(Source(path, text))
 
 
 def parse_rig(source: Source) -> RigFile:
     """The rig that `source` (a rig file's text) describes."""
-    table, problem = _toml(source.text)
-    if problem is not None:
-        return _refused(source, *problem)
+    from mercmac import tomlfile
+
+    try:
+        table = tomlfile.loads(source.text)
+    except tomlfile.TomlError as e:
+        return _refused(source, Span(e.line or 1, e.column or 1), e.why)
     reader = _Reader(source, locate(source.text))
     rig = reader.rig(table)
     return RigFile(source, None if reader.report.has_errors else rig, reader.report,
@@ -65,36 +73,6 @@ def _refused(source: Source, span: Span, error: str) -> RigFile:
     report = Report(source.name)
     report.add("rig-file", span, "toml", error=error)
     return RigFile(source, None, report, Places({}, {}))
-
-
-def _end(text: str) -> Span:
-    """Where a file that ends too early ends."""
-    lines = split_lines(text) or [""]
-    return Span(len(lines), len(lines[-1]) + 1)
-
-
-def _line_of(data: bytes, offset: int) -> Span:
-    return Span(data[:offset].count(b"\n") + 1, 1)
-
-
-def _toml(text: str) -> tuple[dict, tuple[Span, str] | None]:
-    """The TOML table of `text`, or the span and words of why it is no TOML."""
-    import tomllib
-
-    try:
-        return tomllib.loads(to_lf(text)), None  # CR line ends too (SPEC §5), same lines
-    except tomllib.TOMLDecodeError as e:
-        at = _TOML_AT.search(str(e))
-        span = Span(int(at.group(1)), int(at.group(2))) if at and at.group(1) else _end(text)
-        return {}, (span, _TOML_AT.sub("", str(e)).strip())
-    except RecursionError:  # tomllib reads nested arrays by recursion
-        return {}, (Span(1, 1), "arrays or tables nested too deeply to read")
-
-
-def is_name(text: str) -> bool:
-    """Whether TEXT is a rig's or a controller's name: a letter or '_', then letters, digits
-    or '_' (never a path: names become file names)."""
-    return bool(_NAME.match(text))
 
 
 class _Reader:
@@ -109,7 +87,7 @@ class _Reader:
         self._known(table, TOP_KEYS, ())
         tables = self._typed(table, "controllers", dict, "a table", {})
         controllers = self._controllers(tables)
-        names = {name for name in tables if _NAME.match(name)}  # also those with errors
+        names = {name for name in tables if is_name(name)}  # also those with errors
         return Rig(os.path.abspath(self.source.name), self._name(table), controllers,
                    box=self._box(table, names), box_buttons=self._buttons(table),
                    joystick=self._joystick(table, names), wires=self._wires(table, names))
@@ -123,7 +101,8 @@ class _Reader:
         default = stem[:-len(SUFFIX)] if is_rig_path(stem) else stem
         name = self._typed(table, "name", str, "a string", default)
         if name is not default and not is_name(name):
-            self.report.add("rig-file", self.places.of("name"), "rig-name", name=name)
+            self.report.add("rig-file", self.places.of("name"), "rig-name", name=_shown(name),
+                            longest=NAME_MAX)
             return default
         return name
 
@@ -133,8 +112,9 @@ class _Reader:
         found = []
         for name, entry in tables.items():
             path = ("controllers", name)
-            if not _NAME.match(name):
-                self.report.add("rig-file", self.places.of(*path), "name", name=name)
+            if not is_name(name):
+                self.report.add("rig-file", self.places.of(*path), "name", name=_shown(name),
+                                longest=NAME_MAX)
             elif not isinstance(entry, dict):
                 self._wrong(path, "a table: [controllers.NAME] with address, model, program")
             else:
@@ -150,10 +130,22 @@ class _Reader:
         program = self._required(entry, path, "program", str, "a .mcm path", where)
         if isinstance(model, str) and model.upper() not in MODELS:
             self._wrong(path + ("model",), " or ".join(MODELS))
+        if program is not None:
+            program = self._program(program, path + ("program",), name)
         if None in (address, model, program):
             return None
-        return Controller(name, address, model.upper(), os.path.join(self.folder, program),
-                          self.places.of(*path))
+        return Controller(name, address, model.upper(), program, self.places.of(*path))
+
+    def _program(self, program: str, path: tuple[str, ...], name: str) -> str | None:
+        """The program's path, when it is a .mcm file in the rig's folder or below it (SPEC
+        §6); else None, reported at the key without a word of the file (never opened: a
+        rig from elsewhere must not make `check` print /etc/passwd or ~/.aws/credentials)."""
+        why = _why_refused(self.folder, program)
+        if why is not None:
+            self.report.add("rig-file", self.places.of(*path), "program", controller=name,
+                            why=why)
+            return None
+        return os.path.join(self.folder, program)
 
     def _box(self, table: dict, names: set[str]) -> str | None:
         box = self._typed(table, "box", str, "a controller's name", None)
@@ -161,11 +153,15 @@ class _Reader:
 
     def _buttons(self, table: dict) -> tuple[int, ...]:
         buttons = self._typed(table, "box_buttons", list, "a list of buttons 1-4", list(BUTTONS))
-        for button in buttons:
+        span = self.places.of("box_buttons")
+        if "box_buttons" in table and "box" not in table:  # buttons of a box that is not there
+            self.report.add("rig-file", span, "buttons-without-box")
+        for i, button in enumerate(buttons):
             if type(button) is not int or button not in BUTTONS:
-                self.report.add("rig-file", self.places.of("box_buttons"), "button",
-                                button=repr(button))
-        return tuple(b for b in buttons if b in BUTTONS and type(b) is int)
+                self.report.add("rig-file", span, "button", button=_shown(repr(button)))
+            elif button in buttons[:i]:
+                self.report.add("rig-file", span, "button-twice", button=button)
+        return tuple(dict.fromkeys(b for b in buttons if b in BUTTONS and type(b) is int))
 
     def _joystick(self, table: dict, names: set[str]) -> dict[str, str]:
         branches = self._typed(table, "joystick", dict, "a table of branches X, Y, Z", {})
@@ -189,29 +185,30 @@ class _Reader:
     def _wire(self, text: Any, span: Span, names: set[str]) -> Wire | None:
         parsed = _WIRE.match(text) if isinstance(text, str) else None
         if parsed is None:
-            self.report.add("rig-wire", span, "syntax", text=repr(text))
+            self.report.add("rig-wire", span, "syntax", text=_shown(repr(text)))
             return None
-        where = f"the wire '{text.strip()}'"
+        where = f"the wire '{_shown(text.strip())}'"
         ends = [self._line(*parsed.group(1, 2, 3), span, where, names),
                 self._line(*parsed.group(4, 5, 6), span, where, names)]
         if None in ends:
             return None
         wire = Wire(ends[0], ends[1], span)
         if (ends[0].kind, ends[1].kind) != (LineKind.OUT, LineKind.IN):
-            self.report.add("rig-wire", span, "direction", wire=text.strip())
+            self.report.add("rig-wire", span, "direction", wire=_shown(text.strip()))
         elif ends[0].controller == ends[1].controller:
             self.report.add("rig-wire", span, "loop", wire=str(wire))
         else:
             return wire
         return None
 
-    def _line(self, name: str, kind: str, number: str, span: Span, where: str,
+    def _line(self, name: str, kind: str, digits: str, span: Span, where: str,
               names: set[str]) -> Line | None:
-        line = Line(name, LineKind(kind), int(number), span)
-        if not 1 <= line.number <= 4:
-            self.report.add("rig-wire", span, "line", line=str(line), kind=kind + "put")
+        number = digits.lstrip("0")
+        if not (len(number) == 1 and 1 <= int(number) <= 4):  # never int() of 5,000 digits
+            self.report.add("rig-wire", span, "line", line=_shown(f"{name}.{kind}{digits}"),
+                            kind=kind + "put")
         elif self._named(name, ("wires",), where, names, span):
-            return line
+            return Line(name, LineKind(kind), int(number), span)
         return None
 
     # -- keys and types -------------------------------------------------------------------
@@ -221,9 +218,10 @@ class _Reader:
         """`name` if it is a controller of the rig; else None, reported."""
         if name is None or name in names:
             return name
-        close = suggest(name, sorted(names), max(1, len(name) // 3))
+        close = suggest(name, sorted(names), max(1, len(name) // 3)) if is_name(name) else None
         self.report.add("rig-file", span or self.places.of(*path), "unknown-controller",
-                        where=where, name=name, hint=f"; did you mean '{close}'?" if close else "")
+                        where=where, name=_shown(name),
+                        hint=f"; did you mean '{close}'?" if close else "")
         return None
 
     def _known(self, table: dict, keys: tuple[str, ...], path: tuple[str, ...]) -> None:
@@ -253,3 +251,33 @@ class _Reader:
         where = f"in [{'.'.join(path[:-1])}]" if len(path) > 1 else "at the top"
         self.report.add("rig-file", self.places.of(*path), "type", key=path[-1], where=where,
                         expects=expects)
+
+
+def is_name(name: str) -> bool:
+    """Whether `name` may name a controller: an identifier of ASCII letters, digits and '_',
+    at most NAME_MAX characters."""
+    return len(name) <= NAME_MAX and _NAME.match(name) is not None
+
+
+def _why_refused(folder: str, program: str) -> str | None:
+    """Why `program` (as the rig file writes it) is no .mcm file in `folder` or below it;
+    None when it is one. Links are followed by name only (realpath reads no file): a link
+    that stays in the folder is taken, one that leads out of it is not."""
+    if "\0" in program:
+        return "it holds a NUL character, which no file name has"
+    if os.path.isabs(program) or os.path.splitdrive(program)[0]:
+        return "it is an absolute path"
+    path = os.path.join(folder, program)
+    real, home = os.path.realpath(path), os.path.realpath(folder)
+    if os.path.commonpath([real, home]) != home:
+        return "it leads out of the rig file's folder"
+    if not program.lower().endswith(PROGRAM_SUFFIX):
+        return "it does not end in .mcm"
+    if not real.lower().endswith(PROGRAM_SUFFIX):
+        return "it is a link to a file that does not end in .mcm"
+    return None
+
+
+def _shown(text: str, most: int = 60) -> str:
+    """`text`, cut to its first `most` characters (a 5,000-digit wire is said, not echoed)."""
+    return text if len(text) <= most else text[:most] + "…"

@@ -23,10 +23,7 @@ the nearest valid key.
 """
 from __future__ import annotations
 
-import codecs
 import json
-import os
-import stat
 from dataclasses import dataclass
 
 from mercmac.errors import MercmacError
@@ -35,7 +32,6 @@ from mercmac.timespec import TimeSpecError, parse_duration
 from mercmac.vm.machine import Machine
 
 CHECKS = ("outputs", "position", "macro", "running")
-MAX_BYTES = 1_000_000  # far above any hand-written scenario; keeps /dev/zero-like files out
 
 
 class ScenarioError(ValueError):
@@ -77,44 +73,20 @@ class Scenario:
 
 
 def load(path: str) -> Scenario:
-    """Read and validate a scenario file; ScenarioError names the file and the place."""
+    """Read and validate a scenario file; ScenarioError names the file and the place.
+    (mercmac.tomlfile reads it, as settings and rigs are read; an OSError such as no such
+    file is left to the CLI, which names the file.)"""
+    from mercmac import tomlfile
+    from mercmac.source import SourceError
+
     try:
-        import tomllib
-    except ModuleNotFoundError:  # Python 3.10
-        import tomli as tomllib
-    text = _decode(path, _read(path))
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise ScenarioError(f"{path}: not valid TOML: {e}") from None
-    except ValueError:  # int() refuses numbers of more than 4300 digits
-        raise ScenarioError(f"{path}: not valid TOML: a number has far too many digits") from None
-    except RecursionError:  # tomllib nests one call per [ or {
-        raise ScenarioError(f"{path}: not valid TOML: arrays or tables nested too deeply") from None
+        data = tomlfile.read(path).table
+    except SourceError as e:  # a FIFO, /dev/zero, a file of many MB: the scenario's fault
+        raise ScenarioError(f"{path}: {e.strerror}") from None
+    except tomlfile.TomlError as e:
+        at = f" (at line {e.line}, column {e.column})" if e.line else ""
+        raise ScenarioError(f"{path}: {e.why}{at}") from None
     return parse(path, data)
-
-
-def _read(path: str) -> bytes:
-    """The file's bytes; OSError (no such file, ...) is left to the CLI, which names the file."""
-    if not stat.S_ISREG(os.stat(path).st_mode):  # reading a FIFO or /dev/zero never ends
-        raise ScenarioError(f"{path}: not a regular file")
-    with open(path, "rb") as f:
-        raw = f.read(MAX_BYTES + 1)
-    if len(raw) > MAX_BYTES:
-        raise ScenarioError(f"{path}: larger than {MAX_BYTES // 1_000_000} MB; "
-                            "a scenario is a short list of steps and expectations")
-    return raw
-
-
-def _decode(path: str, raw: bytes) -> str:
-    """TOML is UTF-8 (a BOM is allowed); UTF-16 with a BOM, as some Windows editors save, too."""
-    utf16 = raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE))
-    try:
-        return raw.decode("utf-16" if utf16 else "utf-8-sig")
-    except UnicodeDecodeError as e:
-        what = "UTF-16 text, though it starts with a UTF-16 byte order mark" if utf16 else "UTF-8"
-        raise ScenarioError(f"{path}: not {what} (byte {e.start}): "
-                            "save the scenario as UTF-8 TOML") from None
 
 
 def parse(path: str, data: dict) -> Scenario:

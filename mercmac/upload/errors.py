@@ -24,6 +24,11 @@ class Refused(UploadError):
     """Stopped before the first write: nothing on the controller changed."""
 
 
+class ProgramUnreadable(Refused, InputError):
+    """Stopped before the first write because a program of the rig cannot be read: exit
+    code 2, as for any file that cannot be read."""
+
+
 class FlashFailed(UploadError):
     """Stopped after writing began; the message lists what was written and the backup."""
 

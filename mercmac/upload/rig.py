@@ -21,7 +21,8 @@ from mercmac import mdtext, outfile
 from mercmac.upload import backup, flasher, history, protocol, survey
 from mercmac.upload.connect import Identity, identify, open_controller
 from mercmac.upload.controller import Controller, ControllerError
-from mercmac.upload.errors import FlashFailed, FlashInterrupted, NotChosen, Refused
+from mercmac.upload.errors import (FlashFailed, FlashInterrupted, NotChosen,
+                                   ProgramUnreadable, Refused)
 from mercmac.upload.flasher import FlashOptions, FlashResult, Notify
 from mercmac.upload.transport import DEFAULT_BAUD, Timing, Transport
 
@@ -195,7 +196,7 @@ def _read(path: str, watch: RigWatch) -> "Rig":
     controller's model); Refused, after `watch.refused_rig`, when that finds errors."""
     from mercmac.compiler import checking
     from mercmac.diagnostics import Severity
-    from mercmac.rig.checks import check_rig
+    from mercmac.rig.checks import check_rig, unreadable_programs
     from mercmac.rig.load import read_rig
 
     rig_file = read_rig(path)  # OSError: it cannot be read (exit 2)
@@ -203,6 +204,8 @@ def _read(path: str, watch: RigWatch) -> "Rig":
     errors = [d for f in findings for d in f.diagnostics if d.severity is Severity.ERROR]
     if rig_file.rig is None or errors:
         watch.refused_rig(findings)
+        if unreadable_programs(findings):  # I/O, as for the rig file itself (exit 2)
+            raise ProgramUnreadable(f"a program of {path} cannot be read; nothing was flashed")
         raise Refused(f"{path} has errors; nothing was flashed",
                       hint=f"`mercmac check {path}` lists them")
     return rig_file.rig

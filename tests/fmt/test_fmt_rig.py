@@ -33,6 +33,21 @@ def test_fmt_formats_every_program_and_leaves_the_rig_file(rig):
     assert y != MESSY and "macro row {" in y and "MR 500" in y
     assert "the rig file itself is left as written" in result.stderr
     assert "1 file reformatted, 1 file left unchanged" in result.stderr
+    assert f"reformatted {rig.parent / 'y.mcm'}\n" in result.stderr  # named (issue 25 item 3)
+    assert "x.mcm" not in result.stderr  # left unchanged: not named
+
+
+def test_fmt_names_each_plain_file_it_rewrites(tmp_path):
+    """Issue 25 item 3: "1 file reformatted" did not say which file was written."""
+    for name in ("a.mcm", "b.mcm", "c.mcm"):
+        (tmp_path / name).write_text(MESSY, encoding="utf-8")
+    (tmp_path / "c.mcm").write_text(cli("fmt", "-", input=MESSY).stdout, encoding="utf-8")
+    result = cli("fmt", tmp_path)
+    assert result.exit_code == 0, result.output
+    written = [line for line in result.stderr.splitlines() if "reformatted" in line]
+    assert written == [f"mercmac: reformatted {tmp_path / 'a.mcm'}",
+                       f"mercmac: reformatted {tmp_path / 'b.mcm'}",
+                       "2 files reformatted, 1 file left unchanged"]
 
 
 def test_fmt_check_and_diff_change_nothing(rig):

@@ -98,3 +98,67 @@ def test_check_as_a_real_process(broken, tmp_path):
 def test_the_raster_programs_are_in_the_one_layout():
     result = cli("fmt", "--check", *sorted(RASTER.parent.glob("*.mcm")))
     assert result.exit_code == 0, result.output
+
+
+# -- issue 25: hostile rig files through every command that takes a rig ------------------------
+
+SECRET = "aws_secret_access_key = hunter2\n"
+CODES = {"check": 1, "sim": 1, "describe": 1, "fmt": 2}  # fmt: a rig it cannot read is I/O
+
+
+@pytest.mark.parametrize("program", ['"../home/credentials"', '"../home/secret.mcm"',
+                                     '"/proc/self/environ"', '"link.mcm"'])
+@pytest.mark.parametrize("command", sorted(CODES))
+def test_a_program_outside_the_rig_folder_is_never_shown_nor_written(tmp_path, command,
+                                                                     program):
+    """Item 3: `check` printed the lines of ~/.aws/credentials, `fmt` rewrote them."""
+    home = tmp_path / "home"
+    home.mkdir()
+    for name in ("credentials", "secret.mcm"):
+        (home / name).write_text(SECRET, encoding="utf-8")
+    (tmp_path / "rig").mkdir()
+    (tmp_path / "rig" / "link.mcm").symlink_to(home / "secret.mcm")
+    rig = write_rig(tmp_path / "rig", WIRES + controllers().replace('"x.mcm"', program))
+    result = cli(command, rig, catch=True)
+    assert isinstance(result.exception, SystemExit), result.exception
+    assert result.exit_code == CODES[command], result.output
+    assert "hunter2" not in result.output and "must be a .mcm file in the rig file's folder" \
+        in result.output
+    assert [(p.name, p.read_text(encoding="utf-8")) for p in sorted(home.iterdir())] == \
+        [("credentials", SECRET), ("secret.mcm", SECRET)]
+
+
+@pytest.mark.parametrize("toml, where", [
+    (WIRES + controllers().replace('"x.mcm"', '"x\\u0000.mcm"'), ":5:1: error[MR001"),
+    (WIRES + controllers(x="9" * 5000), ":3:11: error[MR001"),
+    (f'wires = ["x.out1 -> y.in{"1" * 5000}"]\n' + controllers(), ":1:10: error[MR003"),
+    (controllers() + f"[joystick]\nX = {'1' * 4400}\n", ":10:5: error[MR001"),
+])
+@pytest.mark.parametrize("command", [["check"], ["sim"], ["describe"], ["fmt"],
+                                     ["emulate", "--rig"]])
+def test_a_nul_or_a_number_of_thousands_of_digits_is_said_not_traced(tmp_path, command, toml,
+                                                                     where):
+    """Item 11: ValueError (embedded null byte; integer string conversion) traced back."""
+    rig = write_rig(tmp_path, toml)
+    result = cli(*command, rig, catch=True)
+    assert isinstance(result.exception, SystemExit), result.exception
+    assert result.exit_code in (1, 2) and f"{rig}{where}" in result.output, result.output
+
+
+def test_an_unreadable_program_is_io_exit_2_with_its_diagnostic(tmp_path):
+    """Item 15: `check RIG` exited 1 where sim, describe and fmt exit 2; an unreadable
+    program is an I/O problem in every command, and check still says where it is named."""
+    rig = write_rig(tmp_path, WIRES + controllers().replace('"y.mcm"', '"gone.mcm"'))
+    result = cli("check", rig)
+    assert result.exit_code == 2
+    assert f"{rig}:9:1: error[MR002 rig-program]: the program of y cannot be read" \
+        in result.output
+    assert cli("check", rig, "--format", "json").exit_code == 2
+    for command in (["sim", rig], ["describe", rig], ["fmt", rig],
+                    ["flash", tmp_path / "no-port", rig]):
+        assert cli(*command).exit_code == 2, command
+
+
+def test_a_rig_error_is_still_exit_1_beside_a_readable_program(tmp_path):
+    rig = write_rig(tmp_path, WIRES + controllers().replace('"y.mcm"', '"y.txt"'))
+    assert cli("check", rig).exit_code == 1

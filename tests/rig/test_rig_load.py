@@ -6,7 +6,7 @@ import pytest
 
 from mercmac.rig.load import is_rig_path, read_rig
 from mercmac.rig.model import LineKind
-from helpers.rig_files import RASTER, WIRES, controllers, write_rig
+from helpers.rig_files import RASTER, WIRES, X, controllers, write_rig
 
 
 def _found(path) -> list[tuple[str, int, int, str]]:
@@ -43,7 +43,7 @@ def test_a_bom_and_crlf_or_cr_line_ends_are_read(tmp_path, end):
 
 
 @pytest.mark.parametrize("toml,code,line,column,words", [
-    ("wires = [\n", "MR001", 2, 1, "not TOML"),
+    ("wires = [\n", "MR001", 2, 1, "not valid TOML"),
     (WIRES + controllers() + "adress = 3\n", "MR001", 10, 1, "unknown key 'adress'"),
     ("colour = 1\n" + WIRES + controllers(), "MR001", 1, 1, "unknown key 'colour'"),
     (WIRES + controllers().replace("address = 1\n", ""), "MR001", 6, 2, "needs 'address'"),
@@ -62,6 +62,19 @@ def test_a_bom_and_crlf_or_cr_line_ends_are_read(tmp_path, end):
     ('[controllers.2x]\naddress = 0\nmodel = "C-663"\nprogram = "x.mcm"\n', "MR001", 1, 2,
      "no controller name"),
     ("name = 'r'\n", "MR001", 1, 1, "names no controller"),
+    # issue 25 item 11: more digits than int() reads, in TOML and in a wire
+    (WIRES + controllers(x="9" * 5000), "MR001", 3, 11, "too many digits"),
+    (f'wires = ["x.out{"9" * 5000} -> y.in1"]\n' + controllers(), "MR003", 1, 10, "numbered 1-4"),
+    (f'wires = ["x.out1 -> y.in{"0" * 5000}"]\n' + controllers(), "MR003", 1, 10, "numbered 1-4"),
+    # issue 25 item 15: ASCII digits and names only; box_buttons twice, or without a box
+    ('wires = ["x.out\u0661 -> y.in1"]\n' + controllers(), "MR003", 1, 10, "a wire is written"),
+    ('wires = ["x.out1 -> y.in\uff11"]\n' + controllers(), "MR003", 1, 10, "a wire is written"),
+    ('wires = ["x\u00e9.out1 -> y.in1"]\n' + controllers(), "MR003", 1, 10, "a wire is written"),
+    ('box = "x"\nbox_buttons = [1, 3, 1]\n' + controllers(), "MR001", 2, 1,
+     "button 1 is listed twice"),
+    ("box_buttons = [1, 3]\n" + controllers(), "MR001", 1, 1, "the rig has no box"),
+    (controllers().replace("controllers.x]", f"controllers.{'a' * 65}]") , "MR001", 1, 2,
+     "at most 64 characters"),
 ])
 def test_a_problem_of_the_file_is_reported_where_it_stands(tmp_path, toml, code, line, column,
                                                            words):
@@ -117,3 +130,97 @@ def test_a_rig_name_is_a_name_never_a_path(tmp_path, name):
 def test_a_rig_name_like_a_controller_name_is_taken(tmp_path):
     path = write_rig(tmp_path, 'name = "stage_1"\n' + WIRES + controllers())
     assert read_rig(str(path)).rig.name == "stage_1"
+
+
+def test_a_name_of_64_characters_is_a_name(tmp_path):
+    name = "a" * 64
+    path = write_rig(tmp_path, controllers().replace("controllers.x]", f"controllers.{name}]"))
+    assert [c.name for c in read_rig(str(path)).rig.controllers] == [name, "y"]
+
+
+def test_box_buttons_are_kept_once_each_in_order(tmp_path):
+    rig = read_rig(str(write_rig(tmp_path, 'box = "y"\nbox_buttons = [3, 1]\n' + controllers())))
+    assert rig.rig.box_buttons == (3, 1)
+
+
+def test_a_rig_reads_without_tomllib(monkeypatch, tmp_path):
+    """Python 3.10 has no tomllib: the rig is read with tomli (issue 25 item 11), whose
+    errors carry their place alike."""
+    from helpers.python310 import without_tomllib
+
+    without_tomllib(monkeypatch)
+    assert read_rig(str(write_rig(tmp_path))).rig.name == "r"
+    assert _found(write_rig(tmp_path, "wires = [\n"))[0][:3] == ("MR001", 2, 1)
+
+
+# -- issue 25 item 3: a program lies in the rig's folder or below it, and ends in .mcm ----------
+
+SECRET = "aws_secret_access_key = hunter2\n"
+
+
+@pytest.fixture
+def outside(tmp_path):
+    """A rig folder `rig/` beside a folder `home/` that holds a secret and a .mcm file."""
+    (tmp_path / "home").mkdir()
+    (tmp_path / "home" / "credentials").write_text(SECRET, encoding="utf-8")
+    (tmp_path / "home" / "p.mcm").write_text(X, encoding="utf-8")
+    (tmp_path / "rig").mkdir()
+    return tmp_path
+
+
+def _program_rig(folder, program: str):
+    return write_rig(folder, WIRES + controllers().replace('"x.mcm"', program))
+
+
+@pytest.mark.parametrize("program, why", [
+    ('"../home/credentials"', "leads out of the rig file's folder"),
+    ('"../home/p.mcm"', "leads out of the rig file's folder"),
+    ('"sub/../../home/p.mcm"', "leads out of the rig file's folder"),
+    ('"/etc/passwd"', "absolute path"),
+    ('"/proc/self/environ"', "absolute path"),
+    ("'{home}/p.mcm'", "absolute path"),
+    ('"x.txt"', "does not end in .mcm"),
+    ('"r.rig.toml"', "does not end in .mcm"),
+    ('"."', "does not end in .mcm"),
+    ('"x\\u0000.mcm"', "NUL character"),
+])
+def test_a_program_path_the_rig_may_not_name_is_an_error_at_its_key(outside, program, why):
+    path = _program_rig(outside / "rig", program.format(home=outside / "home"))
+    found = _found(path)
+    assert found == [("MR001", 5, 1, "the program of x must be a .mcm file in the rig file's "
+                                     f"folder or below it: {found[0][3].split(': ', 1)[1]}")]
+    assert why in found[0][3] and "hunter2" not in found[0][3]
+    assert read_rig(str(path)).rig is None
+
+
+@pytest.mark.parametrize("link, program", [
+    ("p.mcm", "p.mcm"),  # a file link that leads out of the folder
+    ("sub", "sub/p.mcm"),  # a folder link that does
+    ("c.mcm", "c.mcm"),  # to a file that is no .mcm, out of the folder
+])
+def test_a_link_that_leads_out_of_the_folder_is_refused(outside, link, program):
+    target = outside / "home" / ("credentials" if link == "c.mcm" else
+                                 "" if link == "sub" else "p.mcm")
+    (outside / "rig" / link).symlink_to(target)
+    found = _found(_program_rig(outside / "rig", f'"{program}"'))
+    assert [f[:3] for f in found] == [("MR001", 5, 1)] and "leads out" in found[0][3]
+
+
+def test_a_link_that_stays_in_the_folder_is_taken(outside):
+    folder = outside / "rig"
+    (folder / "lib").mkdir()
+    (folder / "lib" / "p.mcm").write_text(X, encoding="utf-8")
+    (folder / "p.mcm").symlink_to("lib/p.mcm")
+    (folder / "notes.txt").write_text(X, encoding="utf-8")
+    (folder / "n.mcm").symlink_to("notes.txt")
+    rig = read_rig(str(_program_rig(folder, '"p.mcm"'))).rig
+    assert rig.controller("x").program == str(folder / "p.mcm")
+    assert read_rig(str(_program_rig(folder, '"lib/p.mcm"'))).rig is not None
+    found = _found(_program_rig(folder, '"n.mcm"'))  # stays in, but is no .mcm file
+    assert [f[:3] for f in found] == [("MR001", 5, 1)] and "link to a file" in found[0][3]
+
+
+def test_a_rig_in_a_linked_folder_takes_its_programs(outside):
+    (outside / "via").symlink_to(outside / "rig")
+    write_rig(outside / "rig")
+    assert read_rig(str(outside / "via" / "r.rig.toml")).rig is not None

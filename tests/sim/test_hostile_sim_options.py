@@ -106,6 +106,22 @@ def test_utf8_scenario_with_a_bom_is_read(write):
     assert sim(write(LED), "--scenario", path).exit_code == 0
 
 
+def test_a_scenario_with_lone_cr_line_ends_is_read(write):
+    """Issue 25 item 11: one TOML reader (mercmac.tomlfile) for scenarios, settings and rigs,
+    each reading LF, CRLF and lone CR line ends alike (SPEC §5)."""
+    path = write(SCENARIO_OK.replace("\n", "\r").encode(), "s.toml")
+    assert sim(write(LED), "--scenario", path).exit_code == 0
+
+
+@pytest.mark.parametrize("text, words", [
+    ('until = "1s"\n[[expect]]\nat = "50ms"\noutputs = ' + "1" * 5000 + "\n",
+     ["s.toml", "too many digits", "line 4, column 11"]),
+    ('until = "1s"\r[[expect]\r', ["s.toml", "not valid TOML", "line 2, column 9"]),
+])
+def test_a_scenario_that_is_no_toml_is_said_with_its_place(write, text, words):
+    refused(sim(write(LED), "--scenario", write(text, "s.toml")), *words)
+
+
 @pytest.mark.parametrize("raw", [
     b'until = "1s"\n# \xff\xfe\n',
     b"\xfe\xff\x00",
@@ -201,7 +217,12 @@ def test_a_fifo_or_device_as_scenario_is_refused_without_hanging(write, tmp_path
 
 
 def test_a_huge_scenario_is_refused(write):
-    path = write("# " + "x" * 2_000_000 + "\n", "s.toml")
+    """The cap of every TOML file mercmac reads (mercmac.tomlfile, issue 25 item 11)."""
+    from mercmac.source import MAX_BYTES
+
+    path = write(b"", "s.toml")
+    with open(path, "r+b") as f:
+        f.truncate(MAX_BYTES + 1)  # sparse: nothing is written, nothing must be read
     refused(sim(write(LED), "--scenario", path), "s.toml", "MB")
 
 
