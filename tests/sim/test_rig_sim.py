@@ -3,15 +3,17 @@ example rasters, a rig built to dead-lock reports it with both macros, joint fas
 gives what stepping gives, and the joystick drives its branch's controller."""
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import pytest
 
-from helpers.rig_sim import RASTER, rig_of
+from helpers.rig_sim import RASTER, rig_of, rig_of_one
 from mercmac.compiler import compile_file
 from mercmac.render import explain
 from mercmac.rig.load import read_rig
 from mercmac.sim.rig import Hold, simulate_rig
+from mercmac.sim.simulate import simulate
 from mercmac.timespec import parse_buttons
 from mercmac.vm import events as ev
 
@@ -152,6 +154,48 @@ def test_a_button_during_the_scan_bounds_the_skip():
     plain = run(RASTER, presses=presses, until_ms=90_000, fast_forward=False)
     assert outcome(fast) == outcome(plain)
     assert fast.runs["x"].machine.macro is not None and fast.runs["y"].final()["target"] < 45_000
+
+
+SPIN = "macro spin { CN 1, CF 1, goto spin }\nautostart { goto spin }\n"
+CALLS = 400_000  # Python and C calls one run of SPIN may make, whatever its --until
+
+
+class OverBudget(Exception):
+    """More calls than the run may make: the skip costs something per pass."""
+
+
+def calls_of(path: Path, until_ms: int):
+    """The run to until_ms and the calls it made (sys.setprofile: a count, not a time); a
+    run that makes more than CALLS fails at once (OverBudget) rather than running for days."""
+    made = 0
+
+    def count(frame, event, arg) -> None:
+        nonlocal made
+        made += 1
+        if made > CALLS:
+            raise OverBudget(f"over {CALLS} calls")
+
+    sys.setprofile(count)
+    try:
+        result = run(path, until_ms=until_ms)
+    finally:
+        sys.setprofile(None)
+    return result, made
+
+
+def test_skipping_passes_that_change_no_wire_costs_nothing_per_pass(tmp_path):
+    # a rig of one controller that blinks out1 in a busy loop: 28.8 million passes a day,
+    # none of which changes a wire; the skip's work does not grow with the passes it skips
+    path = rig_of_one(tmp_path, SPIN)
+    short, short_calls = calls_of(path, 60_000)
+    long, long_calls = calls_of(path, 1500 * 86_400_000)
+    assert long_calls <= short_calls + 1_000
+    program = compile_file(str(tmp_path / "s.mcm")).program
+    alone = simulate(program, until_ms=1500 * 86_400_000)
+    ours = long.runs["s"]  # what `sim FILE` says of the program, the rig says of it
+    assert ours.final() == alone.final()
+    assert (ours.record.outputs, ours.record.dropped) == (alone.record.outputs,
+                                                          alone.record.dropped)
 
 
 def test_the_joystick_drives_its_controller_with_the_cubic_response(tmp_path):
