@@ -69,8 +69,10 @@ def test_a_rig_built_to_dead_lock_names_both_waiting_macros(tmp_path):
     for name in ("x", "y"):
         (hazard,) = result.runs[name].record.hazards
         assert hazard.rule == "rig-deadlock"
-        assert "x waits in hello (MC01) at WN2 for in2 ON (from y.out2)" in hazard.message
-        assert "y waits in answer (MC01) at WN1 for in1 ON (from x.out1)" in hazard.message
+        assert ("x waits in hello (MC01) at WN2 for in2 ON (from y.out2, which stays OFF: "
+                "y waits too)") in hazard.message
+        assert ("y waits in answer (MC01) at WN1 for in1 ON (from x.out1, which stays OFF: "
+                "x waits too)") in hazard.message
         assert hazard.where is not None and hazard.where.ip == 0  # the wait itself
     assert result.hazards == 2
 
@@ -96,7 +98,50 @@ def test_a_controller_that_ended_leaves_the_other_waiting_for_good(tmp_path):
                   '"x.out1 -> y.in1"')
     (hazard,) = run(path, until_ms=1_000).runs["y"].record.hazards
     assert hazard.rule == "rig-deadlock" and hazard.t == 5_000
-    assert "y waits in autostart (MC00) at WN1 for in1 ON (from x.out1)" in hazard.message
+    assert ("y waits in autostart (MC00) at WN1 for in1 ON (from x.out1, which stays OFF: "
+            "x has ended)") in hazard.message
+
+
+# issue 25 item 6: x waits on in3, which nothing drives; y waits on x's line
+UNDRIVEN = ("autostart { WN 3, CN 1 }\n", "autostart { WN 1, CN 2 }\n",
+            '"x.out1 -> y.in1", "y.out2 -> x.in2"')
+
+
+def test_a_wait_on_an_input_nothing_drives_is_part_of_the_dead_lock(tmp_path):
+    result = run(rig_of(tmp_path, *UNDRIVEN), until_ms=5_000)
+    for name in ("x", "y"):
+        (hazard,) = result.runs[name].record.hazards
+        assert hazard.rule == "rig-deadlock" and hazard.t == 0
+        assert ("x waits in autostart (MC00) at WN3 for in3 ON (no wire or box button drives "
+                "it)") in hazard.message
+        assert ("y waits in autostart (MC00) at WN1 for in1 ON (from x.out1, which stays OFF: "
+                "x waits too)") in hazard.message
+
+
+def test_a_dead_lock_waits_for_the_last_scripted_press(tmp_path):
+    # a press of x's in3 is scripted at 2 s (no box: a test's script) and released at 3 s;
+    # x goes on at 2 s, so y goes on too: both end, no dead-lock at all
+    path = rig_of(tmp_path, *UNDRIVEN)
+    pressed = run(path, presses={"x": parse_buttons("3@2s-3s")}, until_ms=5_000)
+    assert pressed.hazards == 0
+    assert [e.pattern for e in pressed.runs["y"].record.outputs] == [2]
+
+
+def test_a_wait_on_an_unwired_input_after_the_other_ended_is_a_dead_lock(tmp_path):
+    # y ends at 5 ms; x waits on in3 from the start: the dead-lock is when y ends
+    path = rig_of(tmp_path, "autostart { WF 2, WN 3 }\n", "autostart { WA 5 }\n",
+                  '"y.out2 -> x.in2"')
+    (hazard,) = run(path, until_ms=1_000).runs["x"].record.hazards
+    assert hazard.rule == "rig-deadlock" and hazard.t == 5_000
+    assert "x waits in autostart (MC00) at WN3 for in3 ON (no wire" in hazard.message
+
+
+def test_a_wait_on_an_input_a_wire_and_a_box_button_drive_is_no_dead_lock(tmp_path):
+    # in1 of y is wired from x.out1 (which x never raises) and has box button 1 (MR008: an
+    # error for check; the simulator still gives a person the benefit of the doubt)
+    path = rig_of(tmp_path, "autostart { WA 5 }\n", "autostart { WN 1, CN 2 }\n",
+                  '"x.out1 -> y.in1"', 'box = "y"\n')
+    assert run(path, until_ms=1_000).hazards == 0
 
 
 def test_a_finished_rig_is_no_dead_lock(tmp_path):
