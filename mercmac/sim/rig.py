@@ -184,10 +184,10 @@ class RigSim:
 
     # ------------------------------------------------------------ dead-lock (MH008)
     def _check_deadlock(self, t: int) -> None:
-        """Nothing is due any more (no timer, move, scripted button or joystick change): no
-        output and so no wire will change. A controller that waits (WN/WF) on an input no
-        box button drives waits for good, the wire's far end or nothing driving it; when
-        every controller has ended or waits for good, and one waits on a line, the rig is
+        """Nothing is due any more (no timer, move, scripted button or joystick change), so
+        no output and no wire will change: a controller that waits (WN/WF) on an input no
+        box button drives waits for good, whether a wire or nothing drives it. When every
+        controller has ended or waits for good, and one waits on a line, the rig is
         dead-locked (SPEC §6). A wait on a box button is a wait for a person, who may
         still come: never a dead-lock."""
         running = {name: m for name, m in self.machines.items() if m.running}

@@ -136,6 +136,17 @@ def test_a_wait_on_an_unwired_input_after_the_other_ended_is_a_dead_lock(tmp_pat
     assert "x waits in autostart (MC00) at WN3 for in3 ON (no wire" in hazard.message
 
 
+def test_a_ws_for_a_move_that_never_ends_leaves_the_other_waiting_for_good(tmp_path):
+    # SV 0: x's move never ends (MH005), so x never raises out1, which y waits for
+    path = rig_of(tmp_path, "autostart { SV 0, MR 100, WS 0, CN 1 }\n",
+                  "autostart { WN 1, CN 2 }\n", '"x.out1 -> y.in1"')
+    result = run(path, until_ms=1_000)
+    assert [h.rule for h in result.runs["x"].record.hazards] == ["ws-never-finishes"]
+    (hazard,) = result.runs["y"].record.hazards
+    assert hazard.rule == "rig-deadlock" and ("(from x.out1, which stays OFF: x waits for a "
+                                              "move that never ends)") in hazard.message
+
+
 def test_a_wait_on_an_input_a_wire_and_a_box_button_drive_is_no_dead_lock(tmp_path):
     # in1 of y is wired from x.out1 (which x never raises) and has box button 1 (MR008: an
     # error for check; the simulator still gives a person the benefit of the doubt)
