@@ -427,7 +427,7 @@ rig it reads a constant level. That is right when something outside the rig
 box on this controller.""", {
         "": "{controller} reads input {number} ({command}), which no wire or box button "
             "of the rig drives"}),
-    Rule("MR011", "wait-cycle", _W, "controllers that wait on each other before either sets its line", """\
+    Rule("MR011", "wait-cycle", _W, "controllers that wait on each other, or on a line nothing drives, for good", """\
 Controller A waits (WN) for an input wired from an output of B, while B
 only raises that output after it has itself waited for an input wired from
 A, which A raises only after its own wait: each waits for the other and
@@ -443,9 +443,21 @@ not follow which way an XN/XF goes, nor a second pass of a loop, so a cycle
 that a button or a branch breaks is still reported, and a dead-lock that
 needs a loop to turn round, or a WF on a line left high, is not. Let one
 side raise its output first (in the autostart macro), or run `mercmac sim`
-on the rig to see the run.""", {
+on the rig to see the run.
+It also reports, at the wait, a dead-lock on an input that no wire and no
+box button drives, which stays OFF on the rig (SPEC §6): only a sure one.
+Each controller is followed from its autostart macro through the commands
+that surely run (no XN/XF condition, no loop without a wait); when each one
+ends or reaches a WN that never ends, on such an input or on a wire from an
+output its controller has not raised by then, and one of them waits on an
+input nothing drives, no controller will go on (`sim` reports it as MH008).
+A wait on an input a box button drives is never counted: a person may press
+it. Wire the input, name the box on that controller, or wait on a line that
+is driven.""", {
         "": "{first} waits for {first_line} before raising {first_out}, and {second} waits "
-            "for {second_line} before raising {second_out}: each waits for the other"}),
+            "for {second_line} before raising {second_out}: each waits for the other",
+        "undriven": "dead-lock: {controller} waits for {line} ({command}) in {macro}, which "
+                    "no wire or box button drives{others}; no controller goes on"}),
     Rule("MR012", "joystick-branch", _E, "a joystick wired in a way it cannot work", """\
 A C-819.20 joystick drives two controllers through its Y-cable, and a
 C-819.30 three through separate cables (MS176E §3.6.1). "If the Y-cable is

@@ -115,6 +115,7 @@ def _rig_rules(rig: Rig, rig_file: RigFile, programs: list[Checked], report: Rep
     _outputs_never_set(rig, lowered, report)
     _inputs_undriven(rig, programs, lowered)
     _wait_cycles(rig, lowered, report)
+    _stuck_on_undriven(rig, programs)
 
 
 # -- addresses and models (§3.2) ----------------------------------------------------------
@@ -332,3 +333,132 @@ def _report_cycle(cycle: list[_Node], driver: dict[str, Wire], report: Report) -
                first_out=str(first.output),
                second=f"{second.output.controller}'s {second_wait[1]}",
                second_line=str(second_wait[0]), second_out=str(second.output))
+
+
+# -- sure dead-locks on an input nothing drives (SPEC §6) --------------------------------
+
+class _Stop(NamedTuple):
+    """Where a controller's sure path from macro 0 stops: the first WN it surely reaches
+    (None: the program ends), and the outputs it may have raised on the way."""
+
+    wait: Step | None
+    raised: frozenset[int]
+
+
+def _stuck_on_undriven(rig: Rig, programs: list[Checked]) -> None:
+    """A dead-lock that is sure and waits on an input nothing drives (a cycle alone is
+    _wait_cycles'): every controller, followed through the commands that surely run, ends
+    or reaches a WN that never ends, on an input no wire and no box button drives (it stays
+    OFF on the rig) or on a wire from an output its controller has not raised by then.
+    Reported at each wait on an undriven input."""
+    stops: dict[str, _Stop] = {}
+    for checked in programs:
+        stop = _sure_stop(rig, checked)
+        if stop is None:
+            return  # a controller that may go on may change anything: nothing is sure
+        stops[checked.controller.name] = stop
+    waiting = {name: stop.wait for name, stop in stops.items() if stop.wait is not None}
+    if not waiting or not all(_never_ends(rig, name, step, stops)
+                              for name, step in waiting.items()):
+        return
+    for checked in programs:
+        name = checked.controller.name
+        step = waiting.get(name)
+        if step is not None and not rig.drivers(name, step.op.arg):
+            others = "".join(f"; {_stuck_text(rig, other, stops)}"
+                             for other in stops if other != name)
+            checked.report.add("wait-cycle", step.op.span or Span(1, 1), "undriven",
+                               controller=name, macro=step.macro, command=step.op.text,
+                               line=str(_input(name, step)), others=others)
+
+
+class _Place(NamedTuple):
+    """Where a machine runs: a macro slot, a command in it, and the one return point."""
+
+    slot: int
+    ip: int
+    ret: tuple[int, int] | None
+
+
+def _sure_stop(rig: Rig, checked: Checked) -> _Stop | None:
+    """The controller's run from macro 0 as the machine runs it, up to its first WN; None
+    where the path is not sure: a condition (XN/XF), an RP that repeats a call or a
+    condition, a loop without a wait, a wait a person or a wire may end at once (WF on a
+    driven input, WN on a box button), or a program with errors."""
+    compilation = checked.findings.compilation if checked.findings else None
+    program = compilation.program if compilation else None
+    if program is None or compilation.report.has_errors:
+        return None
+    name, raised, seen = checked.controller.name, set(), set()
+    place = _settled(program, _Place(0, 0, None)) if 0 in program.macros else None
+    while place is not None:
+        if place in seen:
+            return None  # round a loop without a wait: it runs on
+        seen.add(place)
+        macro = program.macros[place.slot]
+        op = macro.ops[place.ip]
+        if op.mnemonic == Mnemonic.WN:
+            box = op.arg in rig.box_inputs(name)
+            return None if box else _Stop(Step(op, macro.label), frozenset(raised))
+        if not _passes(rig, name, op, macro.ops[:place.ip]):
+            return None
+        raised |= {n for n in range(1, 5) if _sets(op, n)}
+        place = _after(program, place, op)
+    return _Stop(None, frozenset(raised))  # the program ends (§3.8.4)
+
+
+def _passes(rig: Rig, name: str, op: Op, before: list[Op]) -> bool:
+    """Whether `op` surely runs on to the command after it (or into the macro it calls)."""
+    if op.mnemonic in (Mnemonic.XN, Mnemonic.XF):
+        return False  # the rest of the line may not run
+    if op.mnemonic == Mnemonic.WF:  # the lines start OFF: one nothing drives stays OFF
+        return op.arg not in rig.box_inputs(name) and not rig.drivers(name, op.arg)
+    return op.mnemonic != Mnemonic.RP or not _repeats_more(before)
+
+
+def _after(program, place: _Place, op: Op) -> _Place | None:
+    """Where the machine goes after `op` at `place`: into the macro an EM calls, its return
+    point the command after the EM (the one return point, §3.8.4), or on; None: it ends."""
+    if op.mnemonic == Mnemonic.EM and op.arg in program.macros:
+        return _settled(program, _Place(op.arg, 0, (place.slot, place.ip + 1)))
+    return _settled(program, place._replace(ip=place.ip + 1))
+
+
+def _settled(program, place: _Place) -> _Place | None:
+    """`place`, or where a macro's end leads: its return point, or the program's end."""
+    while place.ip >= len(program.macros[place.slot].ops):
+        if place.ret is None:
+            return None
+        place = _Place(*place.ret, None)
+    return place
+
+
+def _repeats_more(before: list[Op]) -> bool:
+    """Whether an RP after `before` would repeat more than plain commands (a call or a
+    condition): its line's second pass may then go elsewhere."""
+    return any(op.mnemonic in (Mnemonic.EM, Mnemonic.XN, Mnemonic.XF) for op in before)
+
+
+def _never_ends(rig: Rig, name: str, step: Step, stops: dict[str, _Stop]) -> bool:
+    """Whether the WN of `step` waits for good while each controller stops where `stops`
+    says: its input is driven by nothing, or by outputs not raised before their stop."""
+    return all(w.source.number not in stops[w.source.controller].raised
+               for w in rig.drivers(name, step.op.arg))
+
+
+def _input(name: str, step: Step) -> Line:
+    return Line(name, LineKind.IN, step.op.arg)
+
+
+def _stuck_text(rig: Rig, name: str, stops: dict[str, _Stop]) -> str:
+    """How another controller of a sure dead-lock stops, for the message."""
+    step = stops[name].wait
+    if step is None:
+        return f"{name} ends"
+    wires = rig.drivers(name, step.op.arg)
+    said = f"{name} waits for {_input(name, step)} ({step.op.text}) in {step.macro}"
+    if not wires:
+        return f"{said}, which nothing drives either"
+    source = wires[0].source
+    before = "it waits too" if stops[source.controller].wait is not None else "it ends"
+    return f"{said}, from {source}, which {source.controller} does not raise before {before}"

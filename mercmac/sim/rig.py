@@ -184,12 +184,16 @@ class RigSim:
 
     # ------------------------------------------------------------ dead-lock (MH008)
     def _check_deadlock(self, t: int) -> None:
-        """Nothing is due any more: when every controller that still runs waits on a wired
-        input, each waits for good. One that waits on a box button or the joystick waits
-        for a person, who may still come: no dead-lock."""
+        """Nothing is due any more (no timer, move, scripted button or joystick change), so
+        no output and no wire will change: a controller that waits (WN/WF) on an input no
+        box button drives waits for good, whether a wire or nothing drives it. When every
+        controller has ended or waits for good, and one waits on a line, the rig is
+        dead-locked (SPEC §6). A wait on a box button is a wait for a person, who may
+        still come: never a dead-lock."""
         running = {name: m for name, m in self.machines.items() if m.running}
-        waiting = {name: m for name, m in running.items() if self._waits_on_wire(name, m)}
-        if not waiting or len(waiting) < len(running):
+        stuck = {name: m for name, m in running.items() if self._stuck(name, m)}
+        waiting = {name: m for name, m in stuck.items() if m.block.wait is not Wait.WS}
+        if not waiting or len(stuck) < len(running):
             return
         self.deadlocked = True
         waits = "; ".join(self._waiting_text(name, m) for name, m in waiting.items())
@@ -198,17 +202,31 @@ class RigSim:
             if message is not None:
                 tell(m, ev.HazardFound(t, DEADLOCK, message, where(m)))
 
-    def _waits_on_wire(self, name: str, m: Machine) -> bool:
+    def _stuck(self, name: str, m: Machine) -> bool:
+        """Whether `m`, with nothing due, waits for good: on an input line no button of the
+        box drives, or in WS for a move that never ends (MH005)."""
         block = m.block
-        return (block is not None and block.wait is not Wait.WS
-                and bool(self.rig.drivers(name, block.arg)))
+        return block is not None and (block.wait is Wait.WS
+                                      or block.arg not in self.rig.box_inputs(name))
 
     def _waiting_text(self, name: str, m: Machine) -> str:
         block = m.block
-        word = "ON" if block.wait is Wait.WN else "OFF"
-        source = " or ".join(str(w.source) for w in self.rig.drivers(name, block.arg))
+        wanted = block.wait is Wait.WN
         return (f"{name} waits in {m.label} at {block.wait.name}{block.arg} for in{block.arg} "
-                f"{word} (from {source})")
+                f"{_word(wanted)} ({self._why_never(name, block.arg, not wanted)})")
+
+    def _why_never(self, name: str, number: int, level: bool) -> str:
+        """Why input `number` of `name` stays at `level`: nothing drives it, or the output
+        at the far end of its wire stays there, its controller ended or waiting too."""
+        wires = self.rig.drivers(name, number)
+        if not wires:
+            return "no wire or box button drives it"
+        source = wires[0].source.controller
+        m = self.machines[source]
+        state = ("has ended" if not m.running
+                 else "waits for a move that never ends" if m.block.wait is Wait.WS
+                 else "waits too")
+        return f"from {wires[0].source}, which stays {_word(level)}: {source} {state}"
 
     def run(self, until_ms: int) -> RigRun:
         """Power on and run to until_ms; Ctrl-C ends the run where it is (`interrupted`)."""
@@ -235,6 +253,10 @@ def _by_source(wires: Iterable[Wire]) -> dict[str, list[Wire]]:
     for wire in wires:
         grouped.setdefault(wire.source.controller, []).append(wire)
     return grouped
+
+
+def _word(on: bool) -> str:
+    return "ON" if on else "OFF"
 
 
 def _next(m: Machine) -> float:

@@ -164,6 +164,8 @@ class JointForward:
         """The wires' edges of the skipped passes: listed up to CAP, the rest counted."""
         sim = self.sim
         count = visit.edges - previous.edges
+        if count == 0:
+            return  # a pass that changes no wire: nothing to copy, whatever `passes` is
         listed = [e for e in sim.edges if previous.t < round(e.t_ms * 1000) <= visit.t]
         if len(listed) < count:  # some of the pass's edges were past the cap already
             sim.edges_dropped += count * passes

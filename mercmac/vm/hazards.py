@@ -72,15 +72,21 @@ the switch state. The simulator places the switch with `sim --reference-at`.""",
     Rule("MH008", "rig-deadlock", _W, "every controller of a rig waits on a line no one will change",
          """\
 In a rig (several controllers wired output to input, MS176E §3.8, §4.5.1) a
-macro that waits with WN/WF on a wired input goes on only when the other
-controller changes the output at the far end of the wire. When every
-controller that still runs waits like that, and no move, button or joystick
-is left to change anything, none of them will ever go on: a dead-lock. On the
-bench the stand stops with no error (a controller that waits on a box button
-or the joystick waits for a person instead: no dead-lock). Typical causes: each side waits for the
-other's signal before giving its own (raise your output before you wait), or
-an output is cleared before the other side saw it. `mercmac check` on the rig
-finds wait cycles in the wiring before a run.""", {
+macro that waits with WN/WF on an input goes on only when that line changes:
+the output at the far end of its wire, or a button of the C-170.PB box. An
+input that no wire and no box button drives never changes on the rig, and an
+output changes only while its controller runs. When every controller has
+ended or waits for good (on an input nothing drives, on a wire from a
+controller that has ended or waits too, or in a WS for a move that never
+ends), and no move, timer, scripted button or joystick change is left, none
+of them will ever go on: a dead-lock. On the bench the stand stops with no
+error. A wait on an input a box button drives is never a dead-lock: a person
+may still press the button. Typical causes: each side waits for the other's
+signal before giving its own (raise your output before you wait), an output
+is cleared before the other side saw it, or a wait on an input that is not
+wired (add the wire, or name the box on that controller). `mercmac check` on
+the rig finds wait cycles and sure dead-locks on unwired inputs before a run
+(MR011).""", {
         "": "dead-lock: {waits}; no one will change these lines"}),
 )
 

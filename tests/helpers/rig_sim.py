@@ -19,3 +19,12 @@ def rig_of(folder: Path, x: str, y: str, wires: str, extra: str = "") -> Path:
                     '[controllers.y]\naddress = 1\nmodel = "C-663"\nprogram = "y.mcm"\n',
                     encoding="utf-8")
     return path
+
+
+def rig_of_one(folder: Path, program: str) -> Path:
+    """A rig file of one C-663, s at address 0, running `program` (`target` added)."""
+    (folder / "s.mcm").write_text("target C-663\n" + program, encoding="utf-8")
+    path = folder / "one.rig.toml"
+    path.write_text('[controllers.s]\naddress = 0\nmodel = "C-663"\nprogram = "s.mcm"\n',
+                    encoding="utf-8")
+    return path

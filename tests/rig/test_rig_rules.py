@@ -182,3 +182,51 @@ def test_two_branches_to_one_controller(tmp_path):
 def test_a_joystick_on_both_branches_is_fine(tmp_path):
     assert _codes(write_rig(tmp_path, WIRES + '[joystick]\nX = "x"\nY = "y"\n' + controllers())) \
         == []
+
+
+# issue 25 item 6: x waits on in3, which no wire and no box button drives, before it raises
+# the line y waits on: a sure dead-lock, reported at x's wait
+STUCK_X = "target C-663\nautostart { WN 3, CN 1 }\n"
+WAITING_Y = "target C-663\nautostart { WN 1, CN 2 }\n"
+
+
+def test_a_sure_dead_lock_on_an_input_nothing_drives(tmp_path):
+    found = sorted(_found(write_rig(tmp_path, x=STUCK_X, y=WAITING_Y)))
+    assert [f[:4] for f in found] == [("MR010", "x.mcm", 2, 13), ("MR011", "x.mcm", 2, 13)]
+    assert found[1][4] == (
+        "dead-lock: x waits for x.in3 (WN3) in autostart (MC00), which no wire or box button "
+        "drives; y waits for y.in1 (WN1) in autostart (MC00), from x.out1, which x does not "
+        "raise before it waits too; no controller goes on")
+
+
+def test_a_controller_that_ends_takes_part_in_a_sure_dead_lock(tmp_path):
+    # y ends at once; x waits on in3 for good
+    found = _found(write_rig(tmp_path, x=STUCK_X, y="target C-663\nautostart { CN 2 }\n"))
+    (stuck,) = [f for f in found if f[0] == "MR011"]
+    assert stuck[1:4] == ("x.mcm", 2, 13) and "; y ends; no controller goes on" in stuck[4]
+
+
+def test_a_rig_of_one_waiting_on_an_input_nothing_drives(tmp_path):
+    (tmp_path / "s.mcm").write_text("target C-663\nautostart { WN 4 }\n", encoding="utf-8")
+    path = tmp_path / "one.rig.toml"
+    path.write_text('[controllers.s]\naddress = 0\nmodel = "C-663"\nprogram = "s.mcm"\n',
+                    encoding="utf-8")
+    assert sorted(_codes(path)) == ["MR010", "MR011"]
+
+
+@pytest.mark.parametrize("toml, x, y", [
+    # a button of the box on x's in3: a person may press it
+    ('box = "x"\nbox_buttons = [3]\n' + WIRES + controllers(), STUCK_X, WAITING_Y),
+    # x raises out1 before it waits: y goes on, and what it does then is not followed
+    (None, "target C-663\nautostart { CN 1, WN 3 }\n", WAITING_Y),
+    # the wait stands behind a condition: it may not be reached
+    (None, "target C-663\nautostart { XN 4, WN 3, CN 1 }\n", WAITING_Y),
+    # y runs on in a loop without a wait: it may change anything
+    (None, STUCK_X, "target C-663\nmacro go { TP, WA 10, goto go }\nautostart { goto go }\n"),
+    # a repeated line with a call in it may go elsewhere the second time
+    (None, "target C-663\nmacro m { CN 1 }\nautostart { EM 1, RP 2, WN 3 }\n", WAITING_Y),
+    # a WF on a wired input may pass or wait: not sure
+    (None, "target C-663\nautostart { WF 2, WN 3, CN 1 }\n", WAITING_Y),
+])
+def test_no_sure_dead_lock_where_a_wait_may_end(tmp_path, toml, x, y):
+    assert "MR011" not in _codes(write_rig(tmp_path, toml, x=x, y=y))

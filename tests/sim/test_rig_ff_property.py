@@ -1,7 +1,8 @@
 """Joint fast-forward of a rig against stepping it (issue 19): two controllers wired to each
 other, running random programs that move, move on the way, report while moving, set the
 trigger, and wait on each other's lines, give the same wire edges, reports, outputs,
-hazards and final state whether the rig's repeating passes are skipped or stepped."""
+hazards and final state whether the rig's repeating passes are skipped or stepped; also
+when the wires join lines the programs never set, so that no pass changes a wire."""
 from __future__ import annotations
 
 import shutil
@@ -22,6 +23,7 @@ from mercmac.sim.rig import simulate_rig
 from mercmac.vm import events as ev
 
 WIRES = '"x.out1 -> y.in1", "y.out2 -> x.in2"'
+QUIET = '"x.out3 -> y.in3", "y.out4 -> x.in4"'  # lines the programs never set: no edge
 
 
 def run(path: Path, until_ms: int, fast_forward: bool):
@@ -65,13 +67,14 @@ prologues = st.sampled_from(["", "ZM2,ZP0,ZI5,", "MA-70000,WS0,", "MA1020,WS0,"]
 @pytest.mark.slow
 @settings(max_examples=budget(60), deadline=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
-@given(x_ops, y_ops, tails, tails, prologues, st.integers(300, 6_000))
+@given(x_ops, y_ops, tails, tails, prologues, st.integers(300, 6_000),
+       st.sampled_from([WIRES, QUIET]))
 def test_a_wired_rig_skipped_gives_what_stepping_gives(xs, ys, x_tail, y_tail, prologue,
-                                                        until_ms):
+                                                        until_ms, wires):
     folder = Path(tempfile.mkdtemp())
     try:
         path = rig_of(folder, f"[MC00] {prologue}EM1\n[MC01] {','.join(xs)},{x_tail}\n",
-                      f"[MC00] EM1\n[MC01] {','.join(ys)},{y_tail}\n", WIRES)
+                      f"[MC00] EM1\n[MC01] {','.join(ys)},{y_tail}\n", wires)
         fast = run(path, until_ms, True)
         plain = run(path, until_ms, False)
         assert outcome(fast) == outcome(plain)
@@ -86,3 +89,12 @@ def test_a_rig_that_moves_on_the_way_skips_together(tmp_path):
     fast, plain = run(path, 20_000, True), run(path, 20_000, False)
     assert outcome(fast) == outcome(plain)
     assert skipped(fast) > 1000
+
+
+def test_passes_that_change_no_wire_skip_together(tmp_path):
+    # x blinks an output no wire takes and y steps on its own: the wires never change
+    path = rig_of(tmp_path, "[MC00] EM1\n[MC01] CN1,WA2,CF1,RP,RP\n",
+                  "[MC00] EM1\n[MC01] MR1,TP,WA5,RP,RP\n", QUIET)
+    fast, plain = run(path, 20_000, True), run(path, 20_000, False)
+    assert outcome(fast) == outcome(plain)
+    assert not fast.edges and skipped(fast) > 500  # of about 1,000 joint passes

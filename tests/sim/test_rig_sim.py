@@ -3,15 +3,17 @@ example rasters, a rig built to dead-lock reports it with both macros, joint fas
 gives what stepping gives, and the joystick drives its branch's controller."""
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import pytest
 
-from helpers.rig_sim import RASTER, rig_of
+from helpers.rig_sim import RASTER, rig_of, rig_of_one
 from mercmac.compiler import compile_file
 from mercmac.render import explain
 from mercmac.rig.load import read_rig
 from mercmac.sim.rig import Hold, simulate_rig
+from mercmac.sim.simulate import simulate
 from mercmac.timespec import parse_buttons
 from mercmac.vm import events as ev
 
@@ -67,8 +69,10 @@ def test_a_rig_built_to_dead_lock_names_both_waiting_macros(tmp_path):
     for name in ("x", "y"):
         (hazard,) = result.runs[name].record.hazards
         assert hazard.rule == "rig-deadlock"
-        assert "x waits in hello (MC01) at WN2 for in2 ON (from y.out2)" in hazard.message
-        assert "y waits in answer (MC01) at WN1 for in1 ON (from x.out1)" in hazard.message
+        assert ("x waits in hello (MC01) at WN2 for in2 ON (from y.out2, which stays OFF: "
+                "y waits too)") in hazard.message
+        assert ("y waits in answer (MC01) at WN1 for in1 ON (from x.out1, which stays OFF: "
+                "x waits too)") in hazard.message
         assert hazard.where is not None and hazard.where.ip == 0  # the wait itself
     assert result.hazards == 2
 
@@ -94,7 +98,61 @@ def test_a_controller_that_ended_leaves_the_other_waiting_for_good(tmp_path):
                   '"x.out1 -> y.in1"')
     (hazard,) = run(path, until_ms=1_000).runs["y"].record.hazards
     assert hazard.rule == "rig-deadlock" and hazard.t == 5_000
-    assert "y waits in autostart (MC00) at WN1 for in1 ON (from x.out1)" in hazard.message
+    assert ("y waits in autostart (MC00) at WN1 for in1 ON (from x.out1, which stays OFF: "
+            "x has ended)") in hazard.message
+
+
+# issue 25 item 6: x waits on in3, which nothing drives; y waits on x's line
+UNDRIVEN = ("autostart { WN 3, CN 1 }\n", "autostart { WN 1, CN 2 }\n",
+            '"x.out1 -> y.in1", "y.out2 -> x.in2"')
+
+
+def test_a_wait_on_an_input_nothing_drives_is_part_of_the_dead_lock(tmp_path):
+    result = run(rig_of(tmp_path, *UNDRIVEN), until_ms=5_000)
+    for name in ("x", "y"):
+        (hazard,) = result.runs[name].record.hazards
+        assert hazard.rule == "rig-deadlock" and hazard.t == 0
+        assert ("x waits in autostart (MC00) at WN3 for in3 ON (no wire or box button drives "
+                "it)") in hazard.message
+        assert ("y waits in autostart (MC00) at WN1 for in1 ON (from x.out1, which stays OFF: "
+                "x waits too)") in hazard.message
+
+
+def test_a_dead_lock_waits_for_the_last_scripted_press(tmp_path):
+    # a press of x's in3 is scripted at 2 s (no box: a test's script) and released at 3 s;
+    # x goes on at 2 s, so y goes on too: both end, no dead-lock at all
+    path = rig_of(tmp_path, *UNDRIVEN)
+    pressed = run(path, presses={"x": parse_buttons("3@2s-3s")}, until_ms=5_000)
+    assert pressed.hazards == 0
+    assert [e.pattern for e in pressed.runs["y"].record.outputs] == [2]
+
+
+def test_a_wait_on_an_unwired_input_after_the_other_ended_is_a_dead_lock(tmp_path):
+    # y ends at 5 ms; x waits on in3 from the start: the dead-lock is when y ends
+    path = rig_of(tmp_path, "autostart { WF 2, WN 3 }\n", "autostart { WA 5 }\n",
+                  '"y.out2 -> x.in2"')
+    (hazard,) = run(path, until_ms=1_000).runs["x"].record.hazards
+    assert hazard.rule == "rig-deadlock" and hazard.t == 5_000
+    assert "x waits in autostart (MC00) at WN3 for in3 ON (no wire" in hazard.message
+
+
+def test_a_ws_for_a_move_that_never_ends_leaves_the_other_waiting_for_good(tmp_path):
+    # SV 0: x's move never ends (MH005), so x never raises out1, which y waits for
+    path = rig_of(tmp_path, "autostart { SV 0, MR 100, WS 0, CN 1 }\n",
+                  "autostart { WN 1, CN 2 }\n", '"x.out1 -> y.in1"')
+    result = run(path, until_ms=1_000)
+    assert [h.rule for h in result.runs["x"].record.hazards] == ["ws-never-finishes"]
+    (hazard,) = result.runs["y"].record.hazards
+    assert hazard.rule == "rig-deadlock" and ("(from x.out1, which stays OFF: x waits for a "
+                                              "move that never ends)") in hazard.message
+
+
+def test_a_wait_on_an_input_a_wire_and_a_box_button_drive_is_no_dead_lock(tmp_path):
+    # in1 of y is wired from x.out1 (which x never raises) and has box button 1 (MR008: an
+    # error for check; the simulator still gives a person the benefit of the doubt)
+    path = rig_of(tmp_path, "autostart { WA 5 }\n", "autostart { WN 1, CN 2 }\n",
+                  '"x.out1 -> y.in1"', 'box = "y"\n')
+    assert run(path, until_ms=1_000).hazards == 0
 
 
 def test_a_finished_rig_is_no_dead_lock(tmp_path):
@@ -152,6 +210,48 @@ def test_a_button_during_the_scan_bounds_the_skip():
     plain = run(RASTER, presses=presses, until_ms=90_000, fast_forward=False)
     assert outcome(fast) == outcome(plain)
     assert fast.runs["x"].machine.macro is not None and fast.runs["y"].final()["target"] < 45_000
+
+
+SPIN = "macro spin { CN 1, CF 1, goto spin }\nautostart { goto spin }\n"
+CALLS = 400_000  # Python and C calls one run of SPIN may make, whatever its --until
+
+
+class OverBudget(Exception):
+    """More calls than the run may make: the skip costs something per pass."""
+
+
+def calls_of(path: Path, until_ms: int):
+    """The run to until_ms and the calls it made (sys.setprofile: a count, not a time); a
+    run that makes more than CALLS fails at once (OverBudget) rather than running for days."""
+    made = 0
+
+    def count(frame, event, arg) -> None:
+        nonlocal made
+        made += 1
+        if made > CALLS:
+            raise OverBudget(f"over {CALLS} calls")
+
+    sys.setprofile(count)
+    try:
+        result = run(path, until_ms=until_ms)
+    finally:
+        sys.setprofile(None)
+    return result, made
+
+
+def test_skipping_passes_that_change_no_wire_costs_nothing_per_pass(tmp_path):
+    # a rig of one controller that blinks out1 in a busy loop: 28.8 million passes a day,
+    # none of which changes a wire; the skip's work does not grow with the passes it skips
+    path = rig_of_one(tmp_path, SPIN)
+    short, short_calls = calls_of(path, 60_000)
+    long, long_calls = calls_of(path, 1500 * 86_400_000)
+    assert long_calls <= short_calls + 1_000
+    program = compile_file(str(tmp_path / "s.mcm")).program
+    alone = simulate(program, until_ms=1500 * 86_400_000)
+    ours = long.runs["s"]  # what `sim FILE` says of the program, the rig says of it
+    assert ours.final() == alone.final()
+    assert (ours.record.outputs, ours.record.dropped) == (alone.record.outputs,
+                                                          alone.record.dropped)
 
 
 def test_the_joystick_drives_its_controller_with_the_cubic_response(tmp_path):

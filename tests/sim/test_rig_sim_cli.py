@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 
-from helpers.cli import mercmac_process, sim
+from helpers.cli import cli, mercmac_process, sim
 from helpers.rig_sim import RASTER, rig_of
 
 SPEC_KEYS = {"until_ms", "halted", "final", "reports", "outputs", "hazards", "events"}
@@ -58,6 +58,20 @@ def test_fail_on_hazard_exits_1_on_a_dead_locked_rig(tmp_path):
     assert "dead-lock" in result.output and "hello (MC01)" in result.output
     assert "answer (MC01)" in result.output and "hazards found (--fail-on-hazard)" in result.output
     assert sim(path, "--until", "1s").exit_code == 0
+
+
+def test_fail_on_hazard_exits_1_on_a_dead_lock_on_an_input_nothing_drives(tmp_path):
+    # issue 25 item 6: x waits on in3, which no wire and no box button drives
+    path = rig_of(tmp_path, "autostart { WN 3, CN 1 }\n", "autostart { WN 1, CN 2 }\n",
+                  '"x.out1 -> y.in1", "y.out2 -> x.in2"')
+    assert cli("check", str(path)).exit_code == 0  # warnings and info, no errors
+    result = sim(path, "--fail-on-hazard", "--until", "1s", "--format", "json")
+    assert result.exit_code == 1
+    out = json.loads(result.stdout)["controllers"]
+    for name in ("x", "y"):
+        (hazard,) = out[name]["hazards"]
+        assert hazard["rule"] == "rig-deadlock" and "in3 ON (no wire or box button" in \
+            hazard["message"]
 
 
 def test_the_joystick_moves_the_controller_of_its_branch(tmp_path):
