@@ -28,17 +28,16 @@ def run(req) -> bool:
     """Carry out a `sim` request on a rig file; False when a file has errors or, under
     --fail-on-hazard, the run found hazards."""
     _refuse_single_only(req)
-    rig = _load(req.file)
-    if rig is None:
+    accepted = checked_rig(req.file)
+    if accepted is None:
         return False
+    rig = accepted.rig
     script = buttons(rig, req.buttons), joystick(rig, req.joystick)
     if req.scenario and script[0]:  # two button scripts for one run: which one wins is a guess
         raise UsageError("--scenario and --buttons cannot be used together: the scenario's "
                          "[[step]] tables are its button script (controller = \"x\" says "
                          "whose)")
-    programs = _compile(rig)
-    if programs is None:
-        return False
+    programs = {name: c.program for name, c in accepted.programs.items()}
     until = _until(req.until, None)
     options = Options(servo_on=not req.servo_off, reference_at=req.reference_at)
     if req.interactive:
@@ -59,32 +58,17 @@ def _refuse_single_only(req) -> None:
                              "model comes from the rig file")
 
 
-def _load(path: str) -> Rig | None:
-    """The rig, or None after showing what is wrong with the rig file (exit 1)."""
-    from mercmac.compiler import Compilation
-    from mercmac.render import report
-    from mercmac.rig.load import read_rig
+def checked_rig(path: str):
+    """The rig and its programs (rig.accept.Accepted) when `check` finds no errors in it;
+    else None after showing what `check` finds (exit 1, as `sim FILE` with errors)."""
+    from mercmac.render.report import write_findings
+    from mercmac.rig.accept import RigRefused, accept
 
     try:
-        rig_file = read_rig(path)
-    except OSError as e:
-        raise UsageError(f"cannot read {path}: {e.strerror or e}") from None
-    if report.write_errors(Compilation(rig_file.source, rig_file.report, rig_file.rig)):
+        return accept(path)
+    except RigRefused as e:
+        write_findings(e.findings)
         return None
-    return rig_file.rig
-
-
-def _compile(rig: Rig) -> dict | None:
-    """Each controller's program with its model; None after showing the errors."""
-    from mercmac.render import report
-    from mercmac.rig.checks import compile_rig
-
-    try:
-        compiled = compile_rig(rig)
-    except OSError as e:
-        raise UsageError(f"cannot read a program of the rig: {e}") from None
-    failed = [name for name, c in compiled.items() if report.write_errors(c)]
-    return None if failed else {name: c.program for name, c in compiled.items()}
 
 
 def buttons(rig: Rig, spec: str) -> dict:
