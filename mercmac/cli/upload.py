@@ -117,8 +117,9 @@ def _timing(timeout: float):
 @click.option("--reset", is_flag=True, help="Send RT afterwards so that macro 0 starts.")
 @click.option("--force", is_flag=True, help="Flash even if the controller is not the file's target.")
 @click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
-@click.option("--only", callback=lambda ctx, param, v: only_names(v), metavar="NAME,..",
-              help="For a rig: flash only these controllers (names from the rig file).")
+@click.option("--only", multiple=True, callback=lambda ctx, param, v: only_names(v),
+              metavar="NAME,..", help="For a rig: flash only these controllers (names from "
+                                      "the rig file): comma-separated or repeated.")
 @_TIMEOUT
 def flash(port, file, port_option, address, baud, dry_run, backup, erase_unused, reset, force,
           target, only, timeout) -> None:
@@ -159,13 +160,16 @@ def flash(port, file, port_option, address, baud, dry_run, backup, erase_unused,
     run_guarded(lambda: _reporting_completion(work, finished))
 
 
-def only_names(value: str | None) -> list[str] | None:
-    """`--only x,y`: the names, each given once."""
-    if value is None:
+def only_names(values: tuple[str, ...]) -> list[str] | None:
+    """`--only x,y` or `--only x --only y` (as `check --select`): every name, each once;
+    None when not given."""
+    if not values:
         return None
-    names = [n.strip() for n in value.split(",")]
-    if not all(names):
-        raise click.BadParameter(f"{value!r} has an empty name: give names such as x,y")
+    names = []
+    for value in values:
+        names += [n.strip() for n in value.split(",")]
+        if not all(names):
+            raise click.BadParameter(f"{value!r} has an empty name: give names such as x,y")
     return list(dict.fromkeys(names))
 
 
