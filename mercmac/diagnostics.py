@@ -339,6 +339,9 @@ text at the position given.""", {
         "branch": "the joystick has no branch '{branch}': its branches are X, Y and Z "
                   "(MS176E §3.6)",
         "button": "the C-170.PB box has no button {button}: its buttons are 1-4 on inputs 1-4",
+        "unread": "the rig cannot be checked: {why}",
+        "internal": "internal error while checking this rig ({detail}); it was not checked - "
+                    "please report this with the file",
     }),
     Rule("MR002", "rig-program", _E, "a controller's program cannot be read", """\
 Each controller's `program` is a `.mcm` path relative to the rig file. The
