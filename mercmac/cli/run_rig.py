@@ -3,8 +3,9 @@ every controller on one clock (sim/rig.py), the merged timeline or JSON out.
 
 `--buttons NAME:B@T1-T2` presses button B of the box, which must be plugged into controller
 NAME (without NAME: the rig's box controller), or the joystick's input 5 or 6 of a controller
-a branch goes to, never an input a wire drives (rig.presses); `--joystick NAME=D@T1-T2` holds the joystick branch of controller NAME
-(or of branch X, Y, Z) at deflection D (-1..1) from T1 to T2, then back to the middle.
+a branch goes to, never an input a wire drives (rig.presses); `--joystick NAME=D@T1-T2` holds
+the joystick branch of controller NAME (or of branch X, Y, Z) at deflection D (-1..1) from T1
+to T2, then back to the middle.
 """
 from __future__ import annotations
 
@@ -103,10 +104,13 @@ def _refuse_unpressable(rig: Rig, name: str, inputs, said: str) -> None:
 
 
 def _box(rig: Rig, item: str) -> str:
+    """The controller a press without a name goes to: the box's."""
+    from mercmac.rig.presses import refusal
+
     if rig.box is None:
-        raise UsageError(f"--buttons '{item}': the rig has no box (box = \"NAME\" in the rig "
-                         "file names the controller it is plugged into); the joystick's inputs "
-                         "5 and 6 take their controller's name: NAME:5@T")
+        raise UsageError(f"--buttons '{item}': {refusal(rig, '', 1)}",
+                         hint="the joystick's inputs 5 and 6 take their controller's name: "
+                              "NAME:5@T1-T2")
     return rig.box
 
 
