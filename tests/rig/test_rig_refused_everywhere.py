@@ -119,3 +119,18 @@ def test_a_rig_file_that_cannot_be_read_is_said_as_check_says_it(tmp_path):
     for args in (("sim", missing), ("describe", missing), ("emulate", "--rig", missing)):
         result = cli(*args, catch=True)
         assert result.exit_code == 2 and result.stderr.strip() == said, args
+
+
+def test_accepted_programs_are_each_controllers_own_compilation(tmp_path):
+    """Two controllers may run one file: each gets it compiled with its own model, the very
+    compilation `check` made (not a second one)."""
+    from mercmac.rig.accept import accept
+
+    program = "autostart { MR 100, WS 0, CN 1 }\n"  # no `target`: the rig's model decides
+    toml = controllers().replace('"y.mcm"', '"x.mcm"').replace(
+        'address = 1\nmodel = "C-663"', 'address = 1\nmodel = "C-863"')
+    path = write_rig(tmp_path, toml, x=program)
+    accepted = accept(str(path))
+    assert {name: c.program.target for name, c in accepted.programs.items()} == {
+        "x": "C-663", "y": "C-863"}
+    assert [f.compilation for f in accepted.findings[1:]] == list(accepted.programs.values())
