@@ -117,13 +117,12 @@ def identified(model: str, firmware: str = "2.30") -> int:
 def rig_main(path: Path = RASTER, framing: str = "etx-per-line") -> float:
     """A full flash of the rig PATH to an empty chain: bytes against the minimum; the ratio."""
     from mercmac.emulator.chain import Chain
-    from mercmac.rig.checks import compile_rig
-    from mercmac.rig.load import read_rig
+    from mercmac.rig.accept import accept
     from mercmac.upload.protocol import select
     from mercmac.upload.rig import flash_rig
 
-    rig = read_rig(str(path)).rig
-    programs = compile_rig(rig)
+    accepted = accept(str(path))
+    rig, programs = accepted.rig, accepted.programs
     need = 0
     for c in rig.controllers:
         lines = {s: m.line for s, m in programs[c.name].program.macros.items()}

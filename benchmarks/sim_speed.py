@@ -162,13 +162,13 @@ def presses_at_one_instant(count: int) -> float:
 
 def raster_stepped(until_ms: int) -> float:
     """Wall seconds of the raster rig stepped instant by instant (no joint fast-forward)."""
-    from mercmac.rig.checks import compile_rig
-    from mercmac.rig.load import read_rig
+    from mercmac.rig.accept import accept
     from mercmac.sim.rig import simulate_rig
     from mercmac.timespec import parse_buttons
 
-    rig = read_rig(RASTER).rig
-    programs = {name: c.program for name, c in compile_rig(rig).items()}
+    accepted = accept(str(RASTER))
+    rig = accepted.rig
+    programs = {name: c.program for name, c in accepted.programs.items()}
     start = time.perf_counter()
     simulate_rig(rig, programs, presses={"x": parse_buttons("1@0-100ms")}, until_ms=until_ms,
                  fast_forward=False)

@@ -352,6 +352,9 @@ the position given.""", {
         "buttons-without-box": "box_buttons lists the buttons of the C-170.PB box, and the "
                                "rig has no box: add box = \"NAME\" (the box's controller) "
                                "or remove box_buttons",
+        "unread": "the rig cannot be checked: {why}",
+        "internal": "internal error while checking this rig ({detail}); it was not checked - "
+                    "please report this with the file",
     }),
     Rule("MR002", "rig-program", _E, "a controller's program cannot be read", """\
 Each controller's `program` is a `.mcm` path relative to the rig file. The

@@ -124,6 +124,15 @@ def _too_large(size: int | None) -> str:
     return f"it is {size / 2**20:.1f} MB: larger than {cap}"
 
 
+def refuse_larger(name: str, text: str) -> None:
+    """SourceError when `text` is more (as UTF-8) than mercmac reads from a file: a file's
+    text that an editor holds is taken as read_bytes takes the file."""
+    # at most 4 bytes a character: a shorter text is not encoded (an editor's, at each key)
+    size = len(text.encode("utf-8", "surrogatepass")) if len(text) > MAX_BYTES // 4 else 0
+    if size > MAX_BYTES:
+        raise SourceError(name, _too_large(size))
+
+
 def read_source(path: str) -> Source:
     """Read a file (or '-' for standard input); OSError (SourceError included) propagates."""
     return Source("<stdin>" if path == "-" else path, decode(read_bytes(path)))

@@ -56,15 +56,14 @@ def _programs(files: tuple[str, ...]) -> tuple[list[str], int]:
 
 def _rig_programs(path: str) -> list[str] | None:
     """The program files of the rig at PATH, or None when the rig cannot be read (said)."""
-    from mercmac.rig.load import read_rig
+    from mercmac.errors import InputError
     from mercmac.render import report as render
+    from mercmac.rig.accept import read
 
     try:
-        rig_file = read_rig(path)
-    except OSError as e:
-        from mercmac import outfile
-
-        say(f"cannot read {path}: {outfile.reason(e)}")
+        rig_file = read(path)  # the rig commands' one reader; fmt runs nothing, so no check
+    except InputError as e:
+        say(e.message)
         return None
     if rig_file.rig is None:
         render.write_text(rig_file.report.items, {rig_file.source.name: rig_file.source}, 1,

@@ -250,15 +250,16 @@ def _is_rig(path: str) -> bool:
 
 def _rig_programs(path: str):
     """The rig at PATH and each controller's program as it would be stored
-    (decompile.Stored, by controller name); _Refused when the rig file or a program has
-    errors (shown as `check` shows them), as `sim RIG` refuses them."""
-    from mercmac.cli.run_rig import _compile, _load
+    (decompile.Stored, by controller name); _Refused when `check` finds errors in the rig
+    (shown as `check` shows them), as `sim RIG` refuses it."""
+    from mercmac.cli.run_rig import checked_rig
     from mercmac.decompile import Stored
 
-    rig = _load(path)  # UsageError (exit 2) when it cannot be read
-    programs = None if rig is None else _compile(rig)
-    if programs is None:
+    accepted = checked_rig(path)  # InputError (exit 2) when it cannot be read
+    if accepted is None:
         raise _Refused()
+    rig = accepted.rig
+    programs = {name: c.program for name, c in accepted.programs.items()}
     return rig, {c.name: Stored({m.slot: m.line for m in programs[c.name].macros.values()},
                                 c.model, programs[c.name].names())
                  for c in rig.controllers}

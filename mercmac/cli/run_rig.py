@@ -1,9 +1,11 @@
 """The work of `mercmac sim RIG` (issue 18 §3, SPEC §6): the rig file and its programs in,
 every controller on one clock (sim/rig.py), the merged timeline or JSON out.
 
-`--buttons NAME:B@T1-T2` presses the box on controller NAME (without NAME: on the rig's
-box controller); `--joystick NAME=D@T1-T2` holds the joystick branch of controller NAME
-(or of branch X, Y, Z) at deflection D (-1..1) from T1 to T2, then back to the middle.
+`--buttons NAME:B@T1-T2` presses button B of the box, which must be plugged into controller
+NAME (without NAME: the rig's box controller), or the joystick's input 5 or 6 of a controller
+a branch goes to, never an input a wire drives (rig.presses); `--joystick NAME=D@T1-T2` holds
+the joystick branch of controller NAME (or of branch X, Y, Z) at deflection D (-1..1) from T1
+to T2, then back to the middle.
 """
 from __future__ import annotations
 
@@ -17,7 +19,7 @@ from mercmac.cli.run import _hold as _held_at_power_on
 from mercmac.outfile import drafting, writable_target
 from mercmac.rig.model import Rig
 from mercmac.sim.rig import Hold, RigRun, RigSim
-from mercmac.timespec import TimeSpecError, parse_buttons, parse_duration
+from mercmac.timespec import TimeSpecError, merge, parse_buttons, parse_duration
 from mercmac.vm.models import Options
 
 _HOLD = re.compile(r"\s*(\w+)\s*=\s*([+-]?(?:\d+\.?\d*|\.\d+))\s*@\s*([^-]+?)\s*(?:-\s*(.+?))?\s*")
@@ -28,17 +30,16 @@ def run(req) -> bool:
     """Carry out a `sim` request on a rig file; False when a file has errors or, under
     --fail-on-hazard, the run found hazards."""
     _refuse_single_only(req)
-    rig = _load(req.file)
-    if rig is None:
+    accepted = checked_rig(req.file)
+    if accepted is None:
         return False
+    rig = accepted.rig
     script = buttons(rig, req.buttons), joystick(rig, req.joystick)
     if req.scenario and script[0]:  # two button scripts for one run: which one wins is a guess
         raise UsageError("--scenario and --buttons cannot be used together: the scenario's "
                          "[[step]] tables are its button script (controller = \"x\" says "
                          "whose)")
-    programs = _compile(rig)
-    if programs is None:
-        return False
+    programs = {name: c.program for name, c in accepted.programs.items()}
     until = _until(req.until, None)
     options = Options(servo_on=not req.servo_off, reference_at=req.reference_at)
     if req.interactive:
@@ -59,54 +60,60 @@ def _refuse_single_only(req) -> None:
                              "model comes from the rig file")
 
 
-def _load(path: str) -> Rig | None:
-    """The rig, or None after showing what is wrong with the rig file (exit 1)."""
-    from mercmac.compiler import Compilation
-    from mercmac.render import report
-    from mercmac.rig.load import read_rig
+def checked_rig(path: str):
+    """The rig and its programs (rig.accept.Accepted) when `check` finds no errors in it;
+    else None after showing what `check` finds (exit 1, as `sim FILE` with errors); a
+    program that cannot be read is shown alike, then raised (exit 2, as for any file)."""
+    from mercmac.render.report import write_findings
+    from mercmac.rig.accept import ProgramsUnread, RigRefused, accept
 
     try:
-        rig_file = read_rig(path)
-    except OSError as e:
-        raise UsageError(f"cannot read {path}: {e.strerror or e}") from None
-    if report.write_errors(Compilation(rig_file.source, rig_file.report, rig_file.rig)):
+        return accept(path)
+    except RigRefused as e:
+        write_findings(e.findings)
+        if isinstance(e, ProgramsUnread):
+            raise
         return None
-    return rig_file.rig
-
-
-def _compile(rig: Rig) -> dict | None:
-    """Each controller's program with its model; None after showing the errors."""
-    from mercmac.render import report
-    from mercmac.rig.checks import compile_rig
-
-    try:
-        compiled = compile_rig(rig)
-    except OSError as e:
-        raise UsageError(f"cannot read a program of the rig: {e}") from None
-    failed = [name for name, c in compiled.items() if report.write_errors(c)]
-    return None if failed else {name: c.program for name, c in compiled.items()}
 
 
 def buttons(rig: Rig, spec: str) -> dict:
-    """`--buttons` on a rig: 'x:1@0-300ms,y:2@1s' by controller; a press without a name
-    goes to the box's controller."""
-    items: dict[str, list[str]] = {}
+    """`--buttons` on a rig: 'x:1@0-300ms,y:5@1s' by controller; a press without a name
+    goes to the box's controller. Only what a person can press (rig.presses): the box's
+    connected buttons on its controller, on inputs no wire drives, and the joystick's inputs
+    on a controller a branch goes to."""
+    found: dict[str, list] = {}
     for item in filter(None, (p.strip() for p in spec.split(","))):
         named = _NAMED.fullmatch(item)
         name, press = (named.group(1), named.group(2)) if named else (_box(rig, item), item)
         _known(rig, name, "--buttons", item)
-        items.setdefault(name, []).append(press)
-    try:
-        return {name: parse_buttons(",".join(presses)) for name, presses in items.items()}
-    except TimeSpecError as e:
-        raise UsageError(f"--buttons: {e}") from None
+        try:
+            pressed = parse_buttons(press)
+        except TimeSpecError as e:
+            raise UsageError(f"--buttons: {e}") from None
+        inputs = {n for p in pressed for n in p.inputs}
+        _refuse_unpressable(rig, name, inputs, f"--buttons '{item}'")
+        found.setdefault(name, []).extend(pressed)
+    return {name: merge(presses) for name, presses in found.items()}
+
+
+def _refuse_unpressable(rig: Rig, name: str, inputs, said: str) -> None:
+    """UsageError, naming the box's controller or the wire, for an input no one can press."""
+    from mercmac.rig.presses import refusal
+
+    for number in sorted(inputs):
+        why = refusal(rig, name, number)
+        if why:
+            raise UsageError(f"{said}: {why}")
 
 
 def _box(rig: Rig, item: str) -> str:
+    """The controller a press without a name goes to: the box's."""
+    from mercmac.rig.presses import refusal
+
     if rig.box is None:
-        first = rig.controllers[0].name
-        raise UsageError(f"--buttons '{item}': the rig has no box; name the controller, "
-                         f"e.g. {first}:{item}")
+        raise UsageError(f"--buttons '{item}': {refusal(rig, '', 1)}",
+                         hint="the joystick's inputs 5 and 6 take their controller's name: "
+                              "NAME:5@T1-T2")
     return rig.box
 
 
@@ -167,21 +174,31 @@ def _interactive(req, rig: Rig, programs: dict, script: tuple, options: Options)
     if rig.box is None:
         raise UsageError("--interactive needs the rig's box: say which controller holds the "
                          "C-170.PB with box = \"NAME\" in the rig file")
+    held = _held_at_power_on(req)
+    _refuse_unpressable(rig, rig.box, held, f"--hold '{req.hold}'")
     sim = _rig_sim(req, rig, programs, script, options, {})
-    hazards = interactive.run(_Box(sim, rig.box), speed=req.speed, hold=_held_at_power_on(req))
+    hazards = interactive.run(_Box(sim, rig), speed=req.speed, hold=held)
     return _hazards_ok(req, hazards)
 
 
 class _Box:
     """The rig as the live box drives one machine (cli/interactive.py): the box's
     controller, whose inputs the keys press and whose events the screen shows, with power-on
-    and the clock those of the whole rig."""
+    and the clock those of the whole rig. A key of an input the box cannot press (a wired
+    one, a button not connected, rig.presses) does nothing: the wire keeps its line."""
 
-    def __init__(self, sim: RigSim, name: str):
-        self._sim, self._machine = sim, sim.machines[name]
+    def __init__(self, sim: RigSim, rig: Rig):
+        from mercmac.rig.presses import refusal
+
+        self._sim, self._machine = sim, sim.machines[rig.box]
+        self._pressable = {n for n in range(1, 7) if refusal(rig, rig.box, n) is None}
 
     def __getattr__(self, name: str):
         return getattr(self._machine, name)
+
+    def set_input(self, n: int, on: bool) -> None:
+        if n in self._pressable:
+            self._machine.set_input(n, on)
 
     def power_on(self) -> None:
         self._sim.power_on()

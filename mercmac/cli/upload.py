@@ -12,7 +12,7 @@ import click
 
 from mercmac.cli.common import MODEL_CHOICE, FiniteFloat, UsageError, run_guarded
 from mercmac.emulator.faults import EmptySlot, Framing  # two enums: light to import
-from mercmac.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
+from mercmac.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, InputError, MercmacError
 
 _ADDRESS = click.option("--address", type=click.IntRange(0, 15), default=0, show_default=True,
                         help="Controller address, DIP switches 1-4 (MS176E §3.1.3).")
@@ -117,8 +117,9 @@ def _timing(timeout: float):
 @click.option("--reset", is_flag=True, help="Send RT afterwards so that macro 0 starts.")
 @click.option("--force", is_flag=True, help="Flash even if the controller is not the file's target.")
 @click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
-@click.option("--only", callback=lambda ctx, param, v: only_names(v), metavar="NAME,..",
-              help="For a rig: flash only these controllers (names from the rig file).")
+@click.option("--only", multiple=True, callback=lambda ctx, param, v: only_names(v),
+              metavar="NAME,..", help="For a rig: flash only these controllers (names from "
+                                      "the rig file): comma-separated or repeated.")
 @_TIMEOUT
 def flash(port, file, port_option, address, baud, dry_run, backup, erase_unused, reset, force,
           target, only, timeout) -> None:
@@ -159,13 +160,16 @@ def flash(port, file, port_option, address, baud, dry_run, backup, erase_unused,
     run_guarded(lambda: _reporting_completion(work, finished))
 
 
-def only_names(value: str | None) -> list[str] | None:
-    """`--only x,y`: the names, each given once."""
-    if value is None:
+def only_names(values: tuple[str, ...]) -> list[str] | None:
+    """`--only x,y` or `--only x --only y` (as `check --select`): every name, each once;
+    None when not given."""
+    if not values:
         return None
-    names = [n.strip() for n in value.split(",")]
-    if not all(names):
-        raise click.BadParameter(f"{value!r} has an empty name: give names such as x,y")
+    names = []
+    for value in values:
+        names += [n.strip() for n in value.split(",")]
+        if not all(names):
+            raise click.BadParameter(f"{value!r} has an empty name: give names such as x,y")
     return list(dict.fromkeys(names))
 
 
@@ -217,14 +221,7 @@ def _rig_watch(port: str, finished: list):
 
     class Shown(rig.RigWatch):
         def refused_rig(self, findings) -> None:
-            from mercmac.diagnostics import Severity
-
-            errors = [d for f in findings for d in f.diagnostics if d.severity is Severity.ERROR]
-            sources = {f.compilation.source.name: f.compilation.source for f in findings}
-            render.write_text(errors, sources, len(findings), sys.stderr)
-
-        def refused(self, compilation) -> None:
-            render.write_errors(compilation)
+            render.write_findings(findings, sys.stderr)
 
         def compiled(self, compilation) -> None:
             render.write_warnings(compilation)
@@ -628,30 +625,18 @@ def _virtual(model: str, address: int, addresses: tuple[int, ...] | None, rig_pa
     return VirtualController(model, address, **kw)
 
 
-# what a chain cannot be served without: the file itself, and an address 0-15 for each (§3.2);
-# the programs do not matter, as the emulated controllers start empty
-_CHAIN_RULES = ("rig-file", "rig-wire", "address-range", "address-repeated")
-
-
 def _emulated_rig(path: str):
-    """The rig at PATH; its file's errors are shown as `check` shows them (exit 2)."""
-    from mercmac.compiler.checking import choice_for
-    from mercmac.outfile import reason
-    from mercmac.render import report as render
-    from mercmac.rig.checks import check_rig
-    from mercmac.rig.load import read_rig
+    """The rig at PATH when `check` finds no errors in it (SPEC §6); else what `check`
+    finds is shown as `check` shows it, and nothing is served (exit 1, as `sim RIG`)."""
+    from mercmac.render.report import write_findings
+    from mercmac.rig.accept import ProgramsUnread, RigRefused, accept
 
     try:
-        rig_file = read_rig(path)
-    except OSError as e:
-        raise UsageError(f"--rig: cannot read {path}: {reason(e)}") from None
-    own = check_rig(rig_file, choice_for(path))[0]  # the rig file's findings come first
-    problems = [d for d in own.compilation.report.items if d.rule.name in _CHAIN_RULES]
-    if rig_file.rig is None or problems:
-        render.write_text(problems, {rig_file.source.name: rig_file.source}, 1, sys.stderr)
-        raise UsageError(f"--rig: {path} has errors; nothing is served",
-                         hint=f"mercmac check {path}")
-    return rig_file.rig
+        return accept(path).rig
+    except RigRefused as e:
+        write_findings(e.findings, sys.stderr)
+        kind = InputError if isinstance(e, ProgramsUnread) else MercmacError  # exit 2 / 1
+        raise kind(f"--rig: {e.message}; nothing is served", hint=e.hint) from None
 
 
 def _served(vc, firmware: str) -> str:

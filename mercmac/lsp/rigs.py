@@ -18,7 +18,7 @@ from mercmac.compiler.checking import Choice
 from mercmac.diagnostics import RULES, Diagnostic, Report
 from mercmac.rig.load import RigFile, is_rig_path, parse_rig, read_rig
 from mercmac.rig.model import Controller, Rig
-from mercmac.source import Source, read_source
+from mercmac.source import Source, Span, read_source, refuse_larger
 
 # How many folders up from a program its rig may stand: a rig holds its programs in its
 # own folder or below (paths relative to the rig file), and a walk to the root of a deep
@@ -43,12 +43,39 @@ class Owner(NamedTuple):
 
 
 def rig_diagnostics(source: Source, choice: Choice) -> list[Diagnostic]:
-    """What `check RIG` reports on the rig file itself (`source`: its name is its path),
-    under `choice`; the programs' own findings belong to their files."""
+    """What `check RIG` reports in the rig file itself (`source`: the editor's text, its name
+    its path), under `choice`: its own findings, and those of a program that is the rig file
+    (the programs' own belong to their files). Where `check` cannot read the rig (too large,
+    a failure reading it or a program), one diagnostic at 1:1 says why: never a clean rig."""
     from mercmac.rig.checks import check_rig
 
-    own, *programs = check_rig(parse_rig(source), choice)
-    return own.diagnostics
+    here = os.path.realpath(source.name)
+
+    def read(path: str) -> Source:  # the rig named as a program: its text as in the editor
+        return source if os.path.realpath(path) == here else read_source(path)
+
+    try:
+        refuse_larger(source.name, source.text)
+        found = check_rig(parse_rig(source), choice, read)
+    except Exception as e:  # what stops `check` (or a bug) is said where the editor shows it
+        return [_unchecked(source, e)]
+    return [d for f in found if os.path.realpath(f.compilation.source.name) == here
+            for d in f.diagnostics]
+
+
+def _unchecked(source: Source, e: Exception) -> Diagnostic:
+    """Why the rig in `source` could not be checked, at 1:1: `check`'s words for a file it
+    cannot read, else the error, as checking reports a compiler bug."""
+    from mercmac.outfile import reason
+
+    report = Report(source.name)
+    if isinstance(e, OSError):
+        report.add("rig-file", Span(1, 1), "unread", why=reason(e))
+    else:
+        detail = f"{type(e).__name__}: {e}"
+        report.add("rig-file", Span(1, 1), "internal",
+                   detail=detail if len(detail) <= 200 else detail[:200] + "...")
+    return report.items[0]
 
 
 def owner_of(path: str, open_text: Callable[[str], str | None]) -> Owner | None:

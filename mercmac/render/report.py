@@ -132,6 +132,15 @@ def write_text(diagnostics: list[Diagnostic], sources: dict[str, Source], files:
     write_lines(lines, stream)
 
 
+def write_findings(findings, stream: IO[str] | None = None) -> None:
+    """Checks' findings (checking.Findings: a compilation and what it reports, one per
+    file) in text, as `check` shows them: `sim`, `describe`, `emulate` and `flash` refuse a
+    rig with errors this way."""
+    write_text([d for f in findings for d in f.diagnostics],
+               {f.compilation.source.name: f.compilation.source for f in findings},
+               len(findings), stream or sys.stderr)
+
+
 def capped(diagnostics: Iterable[Diagnostic], limit: int) -> tuple[list[Diagnostic], dict[str, int]]:
     """The diagnostics in order, at most `limit` per file (0: all), and the count left out per file."""
     kept: list[Diagnostic] = []

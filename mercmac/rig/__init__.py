@@ -3,7 +3,10 @@
 
     NAME.rig.toml --load (locate: positions)--> Rig + the file's own diagnostics
                   --checks--> the rig rules (MRnnn, in mercmac.diagnostics) and each program's
-                              findings; compile_rig: each program with its controller's model
+                              findings; each program checked with its controller's model
+                  --accept--> the Rig and its compiled programs, for the commands that run
+                              it (sim, describe, emulate --rig, flash), or RigRefused with
+                              `check`'s findings
 """
 
 SUFFIX = ".rig.toml"

@@ -70,14 +70,6 @@ def check_rig(rig_file: RigFile, choice: Choice,
     return [own] + [_with_rig_rules(p, choice) for p in programs if p.findings]
 
 
-def compile_rig(rig: Rig) -> dict:
-    """Each controller's program compiled with its controller's model, by name (a
-    Compilation each; InputError when a program cannot be read)."""
-    from mercmac.compiler import compile_file
-
-    return {c.name: compile_file(c.program, c.model) for c in rig.controllers}
-
-
 def _program(controller: Controller, choice: Choice, report: Report,
              rig_file: RigFile, read: Callable[[str], Source] = read_source) -> Checked:
     from mercmac.outfile import reason

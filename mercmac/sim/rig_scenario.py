@@ -1,8 +1,9 @@
 """Scenarios for a rig (issue 18 §3): the steps and expectations of sim/scenario.py, each
-about one controller (`controller = "y"`); a step without one presses the box's buttons
-(the rig's box controller), an expectation without one is about the only controller or
-the box's. All controllers run on one clock (sim/rig.py) while the expectations are
-checked in time order; the first that fails ends the run (ScenarioFailed, exit 1).
+about one controller (`controller = "y"`); a step without one presses the box's buttons (the
+rig's box controller), an expectation without one is about the only controller or the box's.
+A step presses only what a person can (rig.presses). All controllers run on one clock
+(sim/rig.py) while the expectations are checked in time order; the first that fails ends the
+run (ScenarioFailed, exit 1).
 """
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ def run(sim: RigSim, plan: Scenario, until_ms: int) -> int:
     default = _default(sim, plan)
     parts = {name: _part(plan, name, default) for name in sim.machines}
     _refuse_unknown_names(sim, plan)
+    _refuse_unpressable(sim, plan, default)
     for name, part in parts.items():
         one.check_names(sim.machines[name], part)
         one.schedule_steps(sim.machines[name], part)
@@ -56,6 +58,20 @@ def _refuse_unknown_names(sim: RigSim, plan: Scenario) -> None:
         if name is not None and name not in sim.machines:
             raise ScenarioError(f"{plan.name}: controller = \"{name}\": the rig has no "
                                 f"controller of that name ({names})")
+
+
+def _refuse_unpressable(sim: RigSim, plan: Scenario, default: str | None) -> None:
+    """A step presses or releases only what a person can (rig.presses): the box's connected
+    buttons on its controller, on inputs no wire drives; the joystick's on its branches."""
+    from mercmac.rig.presses import refusal
+
+    for step in plan.steps:
+        name = step.controller or default
+        for number in sorted({*step.press, *step.release}):
+            why = refusal(sim.rig, name, number)
+            if why:
+                raise ScenarioError(f"{plan.name}: the step at {step.at_ms} ms on {name}, "
+                                    f"input {number}: {why}")
 
 
 def _check(sim: RigSim, expect: Expect) -> None:

@@ -28,6 +28,7 @@ from mercmac.upload.transport import DEFAULT_BAUD, Timing, Transport
 
 if TYPE_CHECKING:
     from mercmac.compiler import Compilation
+    from mercmac.rig.accept import Accepted
     from mercmac.rig.model import Controller as Member, Rig
 
 
@@ -110,11 +111,8 @@ class RigWatch:
     """What `flash_rig` tells its caller, in order; each part does nothing unless overridden."""
 
     def refused_rig(self, findings: list) -> None:
-        """The rig has errors (rig.checks' Findings, the rig file's first): shown before the
-        refusal."""
-
-    def refused(self, compilation: "Compilation") -> None:
-        """A program has errors for its controller's model: shown before the refusal."""
+        """`check` finds errors in the rig or a program (rig.accept: its Findings, the rig
+        file's first): shown before the refusal."""
 
     def compiled(self, compilation: "Compilation") -> None:
         """A program as it will be flashed (it may have warnings to show)."""
@@ -173,8 +171,9 @@ def flash_rig(port: str, path: str, *, only: list[str] | None = None, baud: int 
     """
     watch = watch or RigWatch()
     options = options or FlashOptions()
-    rig = _read(path, watch)
-    result = RigResult(rig, _parts(rig, only, watch), options.dry_run, options.reset)
+    accepted = _read(path, watch)
+    rig = accepted.rig
+    result = RigResult(rig, _parts(accepted, only, watch), options.dry_run, options.reset)
     for part, target in zip(result.parts, backup_paths(rig, options.backup)):
         if part.chosen and target is not None:
             part.backup_path = backup.check(target)  # refused before the port opens
@@ -191,44 +190,30 @@ def flash_rig(port: str, path: str, *, only: list[str] | None = None, baud: int 
     return result
 
 
-def _read(path: str, watch: RigWatch) -> "Rig":
-    """The rig, checked as `check RIG` checks it (the rig rules and every program with its
-    controller's model); Refused, after `watch.refused_rig`, when that finds errors."""
-    from mercmac.compiler import checking
-    from mercmac.diagnostics import Severity
-    from mercmac.rig.checks import check_rig, unreadable_programs
-    from mercmac.rig.load import read_rig
+def _read(path: str, watch: RigWatch) -> "Accepted":
+    """The rig and its programs, checked as `check RIG` checks it (rig.accept: the rig rules
+    and every program with its controller's model); Refused, after `watch.refused_rig`,
+    when that finds errors. InputError (exit 2) when it or a program cannot be read."""
+    from mercmac.rig.accept import ProgramsUnread, RigRefused, accept
 
-    rig_file = read_rig(path)  # OSError: it cannot be read (exit 2)
-    findings = check_rig(rig_file, checking.choice_for(path))
-    errors = [d for f in findings for d in f.diagnostics if d.severity is Severity.ERROR]
-    if rig_file.rig is None or errors:
-        watch.refused_rig(findings)
-        if unreadable_programs(findings):  # I/O, as for the rig file itself (exit 2)
-            raise ProgramUnreadable(f"a program of {path} cannot be read; nothing was flashed")
-        raise Refused(f"{path} has errors; nothing was flashed",
-                      hint=f"`mercmac check {path}` lists them")
-    return rig_file.rig
+    try:
+        return accept(path)
+    except RigRefused as e:
+        watch.refused_rig(e.findings)
+        kind = ProgramUnreadable if isinstance(e, ProgramsUnread) else Refused
+        raise kind(f"{e.message}; nothing was flashed", hint=e.hint) from None
 
 
-def _parts(rig: "Rig", only: list[str] | None, watch: RigWatch) -> list[Part]:
-    """A Part per controller, the chosen ones compiled for their model; Refused on errors."""
-    from mercmac.rig.checks import compile_rig
-
+def _parts(accepted: "Accepted", only: list[str] | None, watch: RigWatch) -> list[Part]:
+    """A Part per controller, those `only` names (all without it) with their program."""
+    rig = accepted.rig
     names = [c.name for c in rig.controllers]
     unknown = [n for n in only or () if n not in names]
     if unknown:
         raise NotChosen(f"--only names {', '.join(unknown)}, which {rig.path} does not have; "
                         f"nothing was flashed", hint=f"its controllers: {', '.join(names)}")
-    compiled = compile_rig(rig)
-    parts = [Part(c, compiled[c.name] if not only or c.name in only else None,
-                  state=State.UNTOUCHED if not only or c.name in only else State.LEFT_OUT)
-             for c in rig.controllers]
-    for part in parts:
-        if part.chosen and (part.compiled.report.has_errors or part.compiled.program is None):
-            watch.refused(part.compiled)
-            raise Refused(f"{part.member.program} has errors for the {part.member.model} "
-                          f"({part.name}); nothing was flashed")
+    parts = [Part(c, accepted.programs[c.name]) if not only or c.name in only
+             else Part(c, None, state=State.LEFT_OUT) for c in rig.controllers]
     for part in parts:
         if part.chosen:
             watch.compiled(part.compiled)

@@ -150,15 +150,19 @@ def test_a_rig_that_cannot_be_a_chain_is_refused_with_its_place(tmp_path, old, n
     path = rig_at(tmp_path, RIG.replace(old, new))
     proc = subprocess.run([sys.executable, "-m", "mercmac", "emulate", "--rig", str(path)],
                           capture_output=True, text=True, timeout=20)
-    assert proc.returncode == 2 and why in proc.stderr and "Traceback" not in proc.stderr
+    # exit 1, as `sim FILE` with errors and `check` (SPEC §6: refused as `check` refuses it)
+    assert proc.returncode == 1 and why in proc.stderr and "Traceback" not in proc.stderr
     assert "nothing is served" in proc.stderr
 
 
-def test_a_rig_whose_programs_do_not_exist_is_served_empty(tmp_path):
+def test_a_rig_whose_program_does_not_exist_is_refused_as_check_refuses_it(tmp_path):
+    """The emulated controllers start empty, but a rig `check` refuses is not served
+    (SPEC §6): one rig, one answer."""
     path = rig_at(tmp_path)
-    (tmp_path / "x.mcm").unlink()  # the emulated controllers start empty: no program is read
-    with emulating("--rig", str(path)) as (first, _):
-        assert "C-863 at address 0 (x)" in first
+    (tmp_path / "x.mcm").unlink()
+    result = cli("emulate", "--rig", path, catch=True)
+    assert result.exit_code == 2 and "error[MR002 rig-program]" in result.stderr
+    assert "nothing is served" in result.stderr and not result.stdout
 
 
 def test_an_input_two_outputs_drive_is_on_while_either_is():

@@ -9,7 +9,10 @@
 from __future__ import annotations
 
 import asyncio
+import json
+import os
 import shutil
+import subprocess
 import sys
 from pathlib import Path
 
@@ -223,3 +226,70 @@ async def test_the_rig_rules_of_a_program_stand_in_it(client: LanguageClient, ri
     lines = text.split("\n")
     assert {d.code: d.range.start.line for d in found} == {
         "MR007": lines.index("    SC 1"), "MR010": lines.index("    WN 4")}
+
+
+# -- a broken rig is never shown clean (issue 25 item 7) ---------------------------------------
+# Whatever `check RIG` says in the rig file, the editor shows at the same place; where `check`
+# cannot read the rig, one diagnostic at 1:1 says why in its words. The server used to publish
+# nothing for a rig over 16 MB, a rig naming itself as a program, a program path with a NUL and
+# a wire line of 5,000 digits (the last two also crashed `check`: mercmac/rig/load.py).
+SEVERITY = {1: "error", 2: "warning", 3: "info"}
+BROKEN = {
+    "larger than mercmac reads": lambda text: text + "#" * (17 * 1024 * 1024) + "\n",
+    "naming itself as a program": lambda text: text.replace('"axes/y.mcm"', '"raster.rig.toml"'),
+    "a program that is a folder": lambda text: text.replace('"axes/y.mcm"', '"axes"'),
+    "a program path with a NUL": lambda text: text.replace('"axes/y.mcm"', '"axes/y\\u0000.mcm"'),
+    "a wire line of 5,000 digits": lambda text: text.replace('"x.out1 -> y.in1"',
+                                                             '"x.out1 -> y.in' + "1" * 5000 + '"'),
+}
+
+
+def _check_says(rig: Path) -> list[tuple]:
+    """What `mercmac check --format json RIG` (a real process) reports in the rig file itself:
+    (code, severity, start, end, message), positions 0-based as the editor's; a rig it
+    cannot read, as the editor is to show it: MR001 at 1:1 with `check`'s reason."""
+    checked = subprocess.run([sys.executable, "-m", "mercmac", "check", "--format", "json",
+                              str(rig)], capture_output=True, text=True, timeout=120)
+    assert "Traceback" not in checked.stderr, checked.stderr[-2000:]
+    unread = f"mercmac: cannot read {rig}: "
+    if checked.returncode == 2 and checked.stderr.startswith(unread):
+        why = checked.stderr[len(unread):].strip()
+        return [("MR001", "error", (0, 0), (0, 1), f"the rig cannot be checked: {why}")]
+    here = os.path.realpath(rig)
+    return sorted((d["code"], d["severity"], (d["line"] - 1, d["column"] - 1),
+                   (d["end_line"] - 1, d["end_column"] - 1), d["message"])
+                  for d in json.loads(checked.stdout)["diagnostics"]
+                  if os.path.realpath(d["file"]) == here)
+
+
+def _shown(found: list[t.Diagnostic]) -> list[tuple]:
+    return sorted((d.code, SEVERITY[d.severity], (d.range.start.line, d.range.start.character),
+                   (d.range.end.line, d.range.end.character), d.message) for d in found)
+
+
+@pytest.mark.asyncio
+@pytest.mark.parametrize("broken", BROKEN)
+async def test_a_broken_rig_shows_what_check_says(client: LanguageClient, rig: Path, broken):
+    """The NUL and 5,000-digit cases need `check` itself fixed (issue 25 item 11): until
+    then `check` crashes, and this test says so."""
+    text = BROKEN[broken](rig.read_text(encoding="utf-8"))
+    rig.write_text(text, encoding="utf-8")
+    wanted = _check_says(rig)
+    assert wanted and any(w[1] == "error" for w in wanted)  # never clean
+    assert _shown(await _open(client, rig, text, language="toml")) == wanted
+
+
+def test_a_rig_check_that_fails_is_said_at_1_1(monkeypatch, tmp_path):
+    """A bug in the rig checks is a diagnostic on the rig, as a compiler bug is on a file."""
+    from mercmac.compiler.checking import choice_for
+    from mercmac.lsp import rigs
+    from mercmac.rig import checks
+    from mercmac.source import Source
+
+    def broken(*args, **kw):
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr(checks, "check_rig", broken)
+    (found,) = rigs.rig_diagnostics(Source(str(tmp_path / "r.rig.toml"), ""), choice_for(None))
+    assert (found.rule.code, found.span.line, found.span.column) == ("MR001", 1, 1)
+    assert "internal error while checking this rig (RuntimeError: a bug)" in found.message

@@ -6,8 +6,8 @@ import pytest
 
 from mercmac.compiler import checking
 from mercmac.diagnostics import RULES
-from mercmac.rig.checks import check_rig_path, compile_rig
-from mercmac.rig.load import read_rig
+from mercmac.rig.accept import accept
+from mercmac.rig.checks import check_rig_path
 from helpers.rig_files import DEAD_X, DEAD_Y, RASTER, WIRES, X, Y, controllers, write_rig
 
 RIG_CODES = {r.code for r in RULES if r.code.startswith("MR")}
@@ -52,8 +52,8 @@ def test_each_program_is_checked_with_its_controllers_model(tmp_path):
     # no `target` line: DD (a C-863 gain, MS176E §6.4 DD) is refused on the rig's C-663
     path = write_rig(tmp_path, x=X.replace("target C-663\n", "").replace("MR 100,", "DD 10, MR 100,"))
     assert [f[:2] for f in _found(path)] == [("MM010", "x.mcm")]
-    programs = {c: comp.program.target for c, comp in compile_rig(
-        read_rig(str(write_rig(tmp_path, x=X.replace("target C-663\n", "")))).rig).items()}
+    programs = {c: comp.program.target for c, comp in accept(
+        str(write_rig(tmp_path, x=X.replace("target C-663\n", "")))).programs.items()}
     assert programs == {"x": "C-663", "y": "C-663"}
 
 

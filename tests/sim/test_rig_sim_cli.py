@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from helpers.cli import cli, mercmac_process, sim
 from helpers.rig_sim import RASTER, rig_of
 
@@ -170,3 +172,56 @@ def test_a_program_with_errors_is_not_simulated(tmp_path):
     result = sim(path)
     assert result.exit_code == 1
     assert "x.mcm:2:" in result.output and "Simulating" not in result.output
+
+
+# -- what a person can press (issue 25 item 8, SPEC §6) --------------------------------------
+# The raster's box is plugged into x with buttons 1 and 3 connected; x.in2 is wired from y.out2.
+
+@pytest.mark.parametrize("press, words", [
+    ("y:1@0-100ms", "the box is plugged into x"),  # the box is not on y
+    ("x:2@1s", "driven by the wire y.out2 -> x.in2"),  # the run mixed both on one line
+    ("x:4@1s", "button 4 of the box is not connected to x (box_buttons = [1, 3])"),
+    ("x:5@1s", "no joystick branch goes to x"),  # the raster has no joystick
+    ("x:1@0-100ms,x:1+2@2s", "driven by the wire y.out2 -> x.in2"),
+])
+def test_buttons_press_only_what_the_rig_lets_a_person_press(press, words):
+    result = sim(RASTER, "--buttons", press, "--until", "3s")
+    assert result.exit_code == 2, result.output
+    assert words in result.stderr and result.stdout == "" and "Traceback" not in result.output
+
+
+def test_the_joystick_inputs_are_pressed_where_a_branch_goes(tmp_path):
+    path = rig_of(tmp_path, "autostart { every 20ms { when 6 { CN 1 } } }\n",
+                  "autostart { CN 1 }\n", "", '[joystick]\nX = "x"\n')
+    result = sim(path, "--buttons", "x:6@1s-2s", "--until", "3s", "--format", "json")
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.output)["controllers"]["x"]["outputs"], result.output
+    refused = sim(path, "--buttons", "y:6@1s", "--until", "3s")
+    assert refused.exit_code == 2 and "no joystick branch goes to y" in refused.stderr
+
+
+def test_buttons_on_a_rig_without_a_box_are_refused(tmp_path):
+    path = rig_of(tmp_path, "autostart { WN 1, CN 1 }\n", "autostart { CN 1 }\n", "")
+    for press in ("1@1s", "x:1@1s"):
+        result = sim(path, "--buttons", press)
+        assert result.exit_code == 2 and "the rig has no box" in result.stderr, press
+
+
+@pytest.mark.parametrize("step, words", [
+    ('controller = "y"\npress = [1]', "the box is plugged into x"),
+    ("press = [2]", "driven by the wire y.out2 -> x.in2"),
+    ('controller = "x"\nrelease = [2]', "driven by the wire y.out2 -> x.in2"),
+])
+def test_a_scenario_step_presses_only_what_the_rig_lets_a_person_press(tmp_path, step, words):
+    path = tmp_path / "s.toml"
+    path.write_text(f'[[step]]\nat = "1s"\n{step}\n[[expect]]\ncontroller = "x"\nat = "2s"\n'
+                    'running = true\n', encoding="utf-8")
+    result = sim(RASTER, "--scenario", path)
+    assert result.exit_code == 2, result.output
+    assert words in result.stderr and "at 1000 ms on" in result.stderr
+
+
+def test_interactive_holds_only_what_the_box_can_press():
+    result = sim(RASTER, "--interactive", "--hold", "1+2")
+    assert result.exit_code == 2 and "--hold '1+2'" in result.stderr
+    assert "driven by the wire y.out2 -> x.in2" in result.stderr

@@ -29,3 +29,18 @@ def test_a_rig_without_a_box_has_no_interactive_box(tmp_path):
     path = rig_of(tmp_path, "autostart { CN 1 }\n", "autostart { CN 1 }\n", "")
     result = sim(path, "--interactive")
     assert result.exit_code == 2 and "box = " in result.output
+
+
+@pytest.mark.slow
+def test_keys_of_inputs_the_box_cannot_press_do_nothing(tmp_path):
+    """Issue 25 item 8: the box on x has buttons 1 and 3 connected, and x.in2 is y's wire:
+    keys 2 and 4 leave those lines alone (a key 2 used to mix with the wire's level)."""
+    path = rig_of(tmp_path, "autostart { WA 10 }\n", "autostart { CN 1 }\n",
+                  '"y.out2 -> x.in2"', 'box = "x"\nbox_buttons = [1, 3]\n')
+    term = Terminal("sim", str(path), "--interactive", "--hold", "1")
+    term.expect("keys 1-4")
+    term.type("1243")  # 1 lets go of the held button, 3 presses one that is connected
+    term.expect("buttons  1   2  [3]  4 ")
+    term.type("q")
+    term.expect("Summary")
+    assert term.close() == 0

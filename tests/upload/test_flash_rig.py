@@ -174,6 +174,24 @@ def test_cli_only_and_options_that_do_not_go_with_a_rig(rig, data_dir):
     assert "not in --only" in result.output
 
 
+@pytest.mark.parametrize("only", [("--only", "x", "--only", "y"), ("--only", "y,x"),
+                                  ("--only", "x", "--only", "x,y")])
+def test_cli_only_repeated_or_comma_separated_flashes_every_name(rig, data_dir, only):
+    """`--only x --only y` used to flash y alone and call x "untouched"; as `check
+    --select`, the option takes names comma-separated, repeated, or both."""
+    with chain() as (server, vcs, log):
+        result = cli("flash", server.path, rig, *only, *FAST)
+        counts = md_counts(server, vcs)
+    assert result.exit_code == 0, result.output
+    assert counts[0] > 0 and counts[1] > 0 and set(written(log)) == {0, 1}
+    assert "not in --only" not in result.output and "untouched" not in result.output
+
+
+def test_cli_only_repeated_with_an_empty_name_is_refused(rig, data_dir):
+    result = cli("flash", "/dev/null", rig, "--only", "x", "--only", "y,")
+    assert result.exit_code == 2 and "empty name" in result.output
+
+
 def test_cli_a_failure_exits_1_and_names_each_controller(rig, data_dir):
     with chain(models=("C-663", "C-863")) as (server, vcs, log):
         result = cli("flash", server.path, rig, *FAST)
