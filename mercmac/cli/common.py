@@ -139,6 +139,14 @@ def _silence_stdout() -> None:
 
 
 def say(message: str, hint: str | None = None) -> None:
-    click.echo(f"mercmac: {message}", err=True)
+    """The message on standard error, each of its lines escaped: a message quotes file
+    names, ports and option values, which may hold any character (render/names.py)."""
+    click.echo(f"mercmac: {_escaped(message)}", err=True)
     if hint:
-        click.echo(f"  hint: {hint}", err=True)
+        click.echo(f"  hint: {_escaped(hint)}", err=True)
+
+
+def _escaped(text: str) -> str:
+    from mercmac.render.names import printable
+
+    return "\n".join(printable(line) for line in text.split("\n"))

@@ -6,7 +6,7 @@ from mercmac import diagnostics
 from mercmac.diagnostics import Rule
 from mercmac.errors import InputError
 from mercmac.render.console import Line, write_lines
-from mercmac.render.report import printable
+from mercmac.render.names import printable
 from mercmac.vm import hazards
 
 _SEVERITY_STYLE = {"error": "bold red", "warning": "bold yellow", "info": "bold cyan"}
