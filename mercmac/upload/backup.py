@@ -28,10 +28,10 @@ def to_mcm(macros: dict[int, str], version: Version, *, port: str, address: int,
     when = when or _dt.datetime.now().astimezone()
     head = [
         "// Mercury(TM) Macro File",
-        f"// read by mercmac {__version__} from {port}, address {address}, "
+        f"// read by mercmac {__version__} from {comment_text(port)}, address {address}, "
         f"on {when.isoformat(timespec='seconds')}",
         f"// controller: {version.name}, firmware {version.firmware}",
-        f"// VE: {_comment_safe(version.text)}",
+        f"// VE: {comment_text(version.text)}",
         f"// {len(macros)} macro{'s' if len(macros) != 1 else ''} stored",
         f"target {version.model}" if version.model else "// no `target`: VE names no known model",
         "",
@@ -92,5 +92,9 @@ def _port_tag(port: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.]+", "-", tail).strip("-") or "port"
 
 
-def _comment_safe(text: str) -> str:
+def comment_text(text: str) -> str:
+    """TEXT for a one-line comment of a file mercmac writes (this .mcm, a pulled rig's
+    TOML): a newline would end the comment and start a line that is read (a port named
+    `p\n[MC00] ...` would add a macro to the backup), and TOML refuses control characters
+    in a comment; each character that is not printable becomes '?'."""
     return "".join(c if c.isprintable() else "?" for c in text)

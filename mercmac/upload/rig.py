@@ -394,7 +394,7 @@ def rig_text(name: str, members: list[Pulled], port: str) -> str:
     from mercmac import __version__
 
     when = _dt.datetime.now().astimezone().isoformat(timespec="seconds")
-    head = [f"# read by mercmac {__version__} from {_comment(port)} on {when}: the "
+    head = [f"# read by mercmac {__version__} from {backup.comment_text(port)} on {when}: the "
             f"controllers that answered a scan",
             "# Wires cannot be read from controllers (nor which one has the C-170.PB box,",
             "# nor the joystick's branches): add them, e.g. wires = [\"x.out1 -> y.in1\"]",
@@ -405,7 +405,3 @@ def rig_text(name: str, members: list[Pulled], port: str) -> str:
         head += ["", f"[controllers.{m.name}]", f"address = {m.address}", f"model = {model}",
                  f"program = {json.dumps(m.name + '.mcm')}"]
     return "\n".join(head) + "\n"
-
-
-def _comment(text: str) -> str:
-    return "".join(c if c.isprintable() else "?" for c in text)
