@@ -14,6 +14,7 @@ import sys
 from mercmac.cli.common import UsageError
 from mercmac.cli.run import _hazards_ok, _until  # the single controller's, alike
 from mercmac.cli.run import _hold as _held_at_power_on
+from mercmac.names import printable
 from mercmac.outfile import drafting, writable_target
 from mercmac.rig.model import Rig
 from mercmac.sim.rig import Hold, RigRun, RigSim
@@ -68,7 +69,7 @@ def _load(path: str) -> Rig | None:
     try:
         rig_file = read_rig(path)
     except OSError as e:
-        raise UsageError(f"cannot read {path}: {e.strerror or e}") from None
+        raise UsageError(f"cannot read {printable(path)}: {e.strerror or e}") from None
     if report.write_errors(Compilation(rig_file.source, rig_file.report, rig_file.rig)):
         return None
     return rig_file.rig

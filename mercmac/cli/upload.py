@@ -87,7 +87,7 @@ def check_port_arg(port: str | None, option: str | None, command: str) -> str | 
 
 def _port(port: str | None, option: str | None, command: str) -> str:
     """The port to open (mercmac.upload.ports); says on stderr how it was found if not given."""
-    from mercmac.render.names import printable
+    from mercmac.names import printable
     from mercmac.upload import ports as chooser
 
     chosen = chooser.resolve(check_port_arg(port, option, command))
@@ -571,7 +571,7 @@ def emulate(target, address, addresses, rig_path, state, firmware, tm_framing, e
         from mercmac.emulator.virtual import Faults
         from mercmac.emulator.ptyserver import PtyServer
         from mercmac.outfile import appending, reason
-        from mercmac.render.names import printable
+        from mercmac.names import printable
 
         faults = Faults(tm_framing=tm_framing, empty_slot=empty_slot, pace=pace, baud=baud)
         vc = _virtual(target.upper(), address, addresses, rig_path, firmware=firmware,
@@ -628,6 +628,7 @@ _CHAIN_RULES = ("rig-file", "rig-wire", "address-range", "address-repeated")
 def _emulated_rig(path: str):
     """The rig at PATH; its file's errors are shown as `check` shows them (exit 2)."""
     from mercmac.compiler.checking import choice_for
+    from mercmac.names import printable
     from mercmac.outfile import reason
     from mercmac.render import report as render
     from mercmac.rig.checks import check_rig
@@ -636,7 +637,7 @@ def _emulated_rig(path: str):
     try:
         rig_file = read_rig(path)
     except OSError as e:
-        raise UsageError(f"--rig: cannot read {path}: {reason(e)}") from None
+        raise UsageError(f"--rig: cannot read {printable(path)}: {reason(e)}") from None
     own = check_rig(rig_file, choice_for(path))[0]  # the rig file's findings come first
     problems = [d for d in own.compilation.report.items if d.rule.name in _CHAIN_RULES]
     if rig_file.rig is None or problems:

@@ -6,7 +6,7 @@ import json
 
 from mercmac.commands import C663, Mnemonic, lookup
 from mercmac.mdtext import slot_name
-from mercmac.render.names import dot, markdown, mermaid, printable
+from mercmac.names import dot, markdown, mermaid, printable
 from mercmac.render.sim import plural
 from mercmac.timespec import format_span
 from mercmac.decompile.lines import (Line, condition_run, every_period, model_of, names,

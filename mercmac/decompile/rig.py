@@ -12,7 +12,7 @@ from typing import Mapping, NamedTuple
 from mercmac.commands import Mnemonic
 from mercmac.mdtext import slot_name
 from mercmac.decompile.prose import Reader, describe, described, dot_body, mermaid_body
-from mercmac.render.names import dot, markdown, mermaid, printable
+from mercmac.names import dot, markdown, mermaid, printable
 from mercmac.render.sim import plural
 
 # What a command does to the line it names (§6.4: CN/CF/CP set outputs 1-4; WN/WF wait on

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import json
 
+from mercmac.names import printable
 from mercmac.render.console import Line
-from mercmac.render.names import printable
 
 COLUMNS = ("time", "port", "address", "model", "firmware", "file", "macros")
 

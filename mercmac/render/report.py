@@ -6,8 +6,8 @@ import sys
 from typing import IO, Iterable
 
 from mercmac.diagnostics import Diagnostic, Severity
+from mercmac.names import SURROGATES, printable
 from mercmac.render.console import Line, Piece, use_colour, write_lines
-from mercmac.render.names import SURROGATES, printable
 from mercmac.source import Source
 
 _STYLE = {Severity.ERROR: "bold red", Severity.WARNING: "bold yellow", Severity.INFO: "bold cyan"}

@@ -13,10 +13,10 @@ import json
 from itertools import islice
 from typing import IO, Iterator
 
+from mercmac.names import printable
 from mercmac.render import jsontext
 from mercmac.render import sim as one
 from mercmac.render.console import Line, write_lines
-from mercmac.render.names import printable
 from mercmac.sim.record import CAP
 from mercmac.sim.rig import Edge, RigRun
 from mercmac.timespec import format_span

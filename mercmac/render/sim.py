@@ -7,9 +7,9 @@ from itertools import islice
 from typing import IO, Iterator
 
 from mercmac.mdtext import slot_name
+from mercmac.names import printable
 from mercmac.render import jsontext
 from mercmac.render.console import Line, write_lines
-from mercmac.render.names import printable
 from mercmac.timespec import format_clock, format_span
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff

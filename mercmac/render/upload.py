@@ -10,8 +10,8 @@ import sys
 from typing import IO
 
 from mercmac.mdtext import slot_name
+from mercmac.names import printable
 from mercmac.render.console import Line, rich_console, table, use_colour, write_lines
-from mercmac.render.names import printable
 from mercmac.render.sim import plural
 from mercmac.timespec import format_clock
 from mercmac.upload.flasher import Event, EventKind
@@ -31,7 +31,7 @@ def identity_lines(port: str, address: int, identity, warning: str | None = None
     """'C-863, firmware 2.30, at address 0 on /dev/ttyUSB0' and what we had to do;
     `searched`: no --address was given and the address was found by a search; `name`: the
     controller's name in a rig. The port, like every name from outside, is shown escaped
-    (render/names.py): it may hold any character."""
+    (mercmac/names.py): it may hold any character."""
     v = identity.version
     lines: list[Line] = [[(f"{name}: ", "bold"), (f"{v.name}, firmware {v.firmware}", "cyan"),
                           (f", at address {address} on {printable(port)}", "")]]

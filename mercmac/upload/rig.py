@@ -387,14 +387,16 @@ def rig_name(members: list[Pulled]) -> str | None:
 
 def rig_text(name: str, members: list[Pulled], port: str) -> str:
     """A rig file for the pulled controllers (keys as mercmac.rig.load reads them); what a
-    controller cannot tell (wires, box, joystick) is said in a comment."""
+    controller cannot tell (wires, box, joystick) is said in a comment, the port escaped
+    (TOML refuses control characters in a comment, and a newline would end it)."""
     import datetime as _dt
     import json
 
     from mercmac import __version__
+    from mercmac.names import printable
 
     when = _dt.datetime.now().astimezone().isoformat(timespec="seconds")
-    head = [f"# read by mercmac {__version__} from {backup.comment_text(port)} on {when}: the "
+    head = [f"# read by mercmac {__version__} from {printable(port)} on {when}: the "
             f"controllers that answered a scan",
             "# Wires cannot be read from controllers (nor which one has the C-170.PB box,",
             "# nor the joystick's branches): add them, e.g. wires = [\"x.out1 -> y.in1\"]",

@@ -11,7 +11,7 @@ that leaves a mermaid label, markdown markup), and must show the hostile name:
 - in markdown, with the same blocks (headings, lists, one fenced mermaid block) as the plain
   name, parsed by markdown-it-py; in mermaid and Graphviz, with as many statements.
 
-Every output format has its one function in mercmac/render/names.py.
+Every output format has its one function in mercmac/names.py.
 """
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ from helpers.rig_files import X, Y
 from mercmac.emulator.chain import Chain
 from mercmac.emulator.ptyserver import PtyServer
 from mercmac.emulator.virtual import VirtualController
-from mercmac.render import names
+from mercmac import names
 from mercmac.upload import history
 from mercmac.upload.rig import flash_rig
 

@@ -4,9 +4,11 @@ character a file system or an old record allows: an ESC sequence that clears the
 writes the clipboard (OSC 52), a CR or a newline that forges an output line, a bidirectional
 override that shows text reversed, a `"]` that ends a label and starts a statement.
 
-One function per output: `printable` for a terminal (and every other output builds on it),
-`markdown` for inline markdown text, `mermaid` for a mermaid `"..."` label, `dot` for a
-Graphviz `"..."` label. JSON needs none: json.dumps escapes what it must.
+One function per output: `printable` for a terminal, a message or a one-line comment of a
+file mercmac writes (every other output builds on it), `markdown` for inline markdown text,
+`mermaid` for a mermaid `"..."` label, `dot` for a Graphviz `"..."` label. JSON needs none:
+json.dumps escapes what it must. A foundation module: every layer that words a message
+quoting a name (a path, a port) escapes it here.
 """
 from __future__ import annotations
 
