@@ -27,7 +27,7 @@ def to_mcm(macros: dict[int, str], version: Version, *, port: str, address: int,
            when: _dt.datetime | None = None) -> str:
     """The .mcm text: a header comment, `target`, then one `[MCnn]` line per stored slot.
     The port and VE's text are escaped (mercmac.names): a newline in a port's name would end
-    the comment, and what follows it (`[MC00] MR9`) would be a macro of the backup."""
+    the comment, and what follows it would be read as lines of the program."""
     when = when or _dt.datetime.now().astimezone()
     head = [
         "// Mercury(TM) Macro File",

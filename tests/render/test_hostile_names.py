@@ -27,12 +27,13 @@ from markdown_it import MarkdownIt
 from markdown_it.tree import SyntaxTreeNode
 
 from helpers.cli import cli
-from helpers.emulator import FAST, FAST_TIMING
+from helpers.emulator import FAST, FAST_TIMING, serve
 from helpers.rig_files import X, Y
 from mercmac.emulator.chain import Chain
 from mercmac.emulator.ptyserver import PtyServer
 from mercmac.emulator.virtual import VirtualController
 from mercmac import names
+from mercmac.compiler import compile_file
 from mercmac.upload import history
 from mercmac.upload.rig import flash_rig
 
@@ -121,6 +122,31 @@ def _flash_dry_run(tmp: Path, name: str) -> str:
         return _output("flash", server.path, _rig(tmp / "rig", name), "--dry-run", *FAST)
 
 
+def _port(tmp: Path, server, name: str) -> Path:
+    """The pty by a name of its own: a link named `port` + NAME (any name opens it)."""
+    link = tmp / f"port{name}"
+    link.symlink_to(server.path)
+    return link
+
+
+def _flash_file(tmp: Path, name: str) -> str:
+    """A program flashed through a port, to a backup file, all three named after `name`."""
+    program = tmp / f"{name}.mcm"
+    program.write_text(X, encoding="utf-8")
+    with serve(model="C-663") as (server, _):
+        return _output("flash", _port(tmp, server, name), program, "--backup",
+                       tmp / f"b{name}.mcm", *FAST)
+
+
+def _pull_file(tmp: Path, name: str) -> str:
+    """`pull` through a port named after `name`, into a file named so: what it says, and the
+    file's header comment, which names the port."""
+    output = tmp / f"{name}.mcm"
+    with serve(model="C-663", macros={0: "MR5"}) as (server, _):
+        said = _output("pull", _port(tmp, server, name), "-o", output, *FAST)
+    return said + output.read_text(encoding="utf-8")
+
+
 def _flashed_by_an_old_mercmac(server, tmp: Path, name: str) -> None:
     """The rig flashed, then its records changed as a file of the history may hold them:
     the rig's name is `name`."""
@@ -131,9 +157,13 @@ def _flashed_by_an_old_mercmac(server, tmp: Path, name: str) -> None:
 
 
 def _pull_rig(tmp: Path, name: str) -> str:
+    """What `pull --rig` says, through a port named after `name` too, and the rig file it
+    writes, whose comment names the port."""
     with _chain() as server:
         _flashed_by_an_old_mercmac(server, tmp, name)
-        return _output("pull", server.path, "--rig", tmp / "pulled", *FAST)
+        said = _output("pull", _port(tmp, server, name), "--rig", tmp / "pulled", *FAST)
+    rig_file, = (tmp / "pulled").glob("*.rig.toml")
+    return said + rig_file.read_text(encoding="utf-8")
 
 
 def _decompile_rig(tmp: Path, name: str) -> str:
@@ -167,7 +197,8 @@ def _sim(tmp: Path, name: str) -> str:
 
 SURFACES = {"sim": _sim, "describe text": _describe_text, "describe markdown": _describe_markdown,
             "describe --graph dot": _describe_graph, "flash": _flash,
-            "flash --dry-run": _flash_dry_run, "pull --rig": _pull_rig,
+            "flash --dry-run": _flash_dry_run, "flash FILE": _flash_file, "pull -o": _pull_file,
+            "pull --rig": _pull_rig,
             "decompile --port --rig": _decompile_rig, "history": _history}
 _PLAIN: dict[str, str] = {}  # each surface's output for the plain name, made once
 
@@ -175,6 +206,7 @@ _PLAIN: dict[str, str] = {}  # each surface's output for the plain name, made on
 def _shown(surface: str, folder: Path, name: str, monkeypatch) -> str:
     """What SURFACE shows for NAME, with a flash history of its own in FOLDER."""
     monkeypatch.setenv("MERCMAC_DATA_DIR", str(folder / "data"))
+    folder.mkdir(parents=True)
     return SURFACES[surface](folder, name)
 
 
@@ -194,6 +226,29 @@ def test_a_hostile_name_is_shown_escaped_in_as_many_lines(surface, hostile, tmp_
     _assert_safe(shown, plain)
     assert names.printable(hostile) in shown or names.markdown(hostile) in shown or \
         names.dot(hostile) in shown, "the name is not shown"
+
+
+@pytest.mark.parametrize("command", [("sim",), ("describe",), ("flash", "/dev/null"),
+                                     ("build",), ("decompile",)], ids=lambda c: c[0])
+def test_a_file_that_cannot_be_read_is_named_escaped_on_one_line(command, tmp_path):
+    hostile = HOSTILE["newline"] + HOSTILE["osc52"] + HOSTILE["bidi"]
+    said = []
+    for name in (PLAIN, hostile):
+        result = cli(*command, tmp_path / f"{name}.mcm", color=True)
+        assert result.exit_code == 2, result.output
+        said.append(result.output)
+    _assert_safe(said[1], said[0])
+
+
+def test_a_port_name_adds_no_line_to_what_pull_writes(tmp_path):
+    """The file's header comment names the port: a newline there would make the rest of
+    the name a line of the program."""
+    output = tmp_path / "pulled.mcm"
+    with serve(model="C-663", macros={0: "MR5"}) as (server, _):
+        _output("pull", _port(tmp_path, server, "\n[MC05] MR9\n"), "-o", output, *FAST)
+    compilation = compile_file(str(output))
+    assert not compilation.report.has_errors, compilation.report.items
+    assert set(compilation.program.macros) == {0}
 
 
 # -- markdown, mermaid and Graphviz keep their structure ------------------------------------------
