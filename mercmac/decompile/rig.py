@@ -203,7 +203,9 @@ def rig_graph_dot(rig, programs: Mapping[str, Stored]) -> str:
 def _mermaid(rig, readers) -> str:
     out = ["graph LR"]
     for c in rig.controllers:
-        out += [f'    subgraph {c.name}["{mermaid(_heading(c))}"]',
+        # `end` and mermaid's other keywords are good controller names but no subgraph ids;
+        # `_rig` is no end of a node id (`x_MC01`, `x_out1`)
+        out += [f'    subgraph {c.name}_rig["{mermaid(_heading(c))}"]',
                 *mermaid_body(readers[c.name], prefix=f"{c.name}_", indent="        "),
                 *[f'        {_line_id(line)}>"{line.kind}{line.number}"]'
                   for line in _wired_lines(rig, c.name)],

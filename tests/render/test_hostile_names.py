@@ -315,6 +315,26 @@ def test_markdown_keeps_its_blocks_and_the_mermaid_graph_its_statements(hostile,
     assert text.endswith(f": {names.printable(hostile)}.mcm")  # the name, as the text shows it
 
 
+# Words mermaid's flowchart lexer reads as keywords where an id stands (flow.jison)
+MERMAID_KEYWORDS = {"end", "graph", "flowchart", "subgraph", "click", "style", "class",
+                    "classDef", "linkStyle", "direction", "call", "href", "default"}
+
+
+def test_controllers_named_like_mermaid_keywords_name_no_subgraph(tmp_path):
+    """`end` is a good controller name, and `subgraph end[...]` would end the graph early."""
+    rig = tmp_path / "k.rig.toml"
+    (tmp_path / "a.mcm").write_text(X, encoding="utf-8")
+    (tmp_path / "b.mcm").write_text(Y, encoding="utf-8")
+    rig.write_text('wires = ["end.out1 -> graph.in1", "graph.out2 -> end.in2"]\n'
+                   '[controllers.end]\naddress = 0\nmodel = "C-663"\nprogram = "a.mcm"\n'
+                   '[controllers.graph]\naddress = 1\nmodel = "C-663"\nprogram = "b.mcm"\n',
+                   encoding="utf-8")
+    graph = _output("describe", rig, "--format", "markdown").split("## Call graph")[-1]
+    ids = re.findall(r"^\s*subgraph (\S+?)\[", graph, re.M)
+    assert len(ids) == 2 and not set(ids) & MERMAID_KEYWORDS
+    assert len(re.findall(r"^\s*end$", graph, re.M)) == 2
+
+
 @pytest.mark.parametrize("hostile", HOSTILE.values(), ids=HOSTILE.keys())
 def test_the_graphviz_graph_keeps_its_statements(hostile, tmp_path, monkeypatch):
     plain = _plain("describe --graph dot", tmp_path, monkeypatch)
