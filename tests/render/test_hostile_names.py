@@ -28,6 +28,7 @@ from markdown_it.tree import SyntaxTreeNode
 
 from helpers.cli import cli
 from helpers.emulator import FAST, FAST_TIMING, serve
+from helpers.paths import EXAMPLE4, ROOT
 from helpers.rig_files import X, Y
 from mercmac.emulator.chain import Chain
 from mercmac.emulator.ptyserver import PtyServer
@@ -37,6 +38,7 @@ from mercmac.compiler import compile_file
 from mercmac.upload import history
 from mercmac.upload.rig import flash_rig
 
+SCENARIO = ROOT / "examples" / "scenarios" / "manual-example4-four-modes.mode2.toml"
 FORGED = "all controllers verified"
 PLAIN = "x"
 HOSTILE = {
@@ -195,7 +197,14 @@ def _sim(tmp: Path, name: str) -> str:
     return shown.getvalue()
 
 
-SURFACES = {"sim": _sim, "describe text": _describe_text, "describe markdown": _describe_markdown,
+def _sim_scenario(tmp: Path, name: str) -> str:
+    """`sim FILE --scenario` with a scenario file named after `name`: its closing line."""
+    scenario = tmp / f"{name}.toml"
+    scenario.write_text(SCENARIO.read_text(encoding="utf-8"), encoding="utf-8")
+    return _output("sim", EXAMPLE4, "--scenario", scenario)
+
+
+SURFACES = {"sim": _sim, "sim --scenario": _sim_scenario, "describe text": _describe_text, "describe markdown": _describe_markdown,
             "describe --graph dot": _describe_graph, "flash": _flash,
             "flash --dry-run": _flash_dry_run, "flash FILE": _flash_file, "pull -o": _pull_file,
             "pull --rig": _pull_rig,
