@@ -30,11 +30,11 @@ from helpers.cli import cli
 from helpers.emulator import FAST, FAST_TIMING, serve
 from helpers.paths import EXAMPLE4, ROOT
 from helpers.rig_files import X, Y
+from mercmac import names
+from mercmac.compiler import compile_file
 from mercmac.emulator.chain import Chain
 from mercmac.emulator.ptyserver import PtyServer
 from mercmac.emulator.virtual import VirtualController
-from mercmac import names
-from mercmac.compiler import compile_file
 from mercmac.upload import history
 from mercmac.upload.rig import flash_rig
 
@@ -151,7 +151,7 @@ def _pull_file(tmp: Path, name: str) -> str:
 
 def _flashed_by_an_old_mercmac(server, tmp: Path, name: str) -> None:
     """The rig flashed, then its records changed as a file of the history may hold them:
-    the rig's name is `name`."""
+    the rig's name is `name` (which `pull --rig` may take for its rig file, or leave)."""
     flash_rig(server.path, str(_rig(tmp / "rig", "x")), timing=FAST_TIMING)
     for path in history.folder().iterdir():
         record = json.loads(path.read_text(encoding="utf-8"))
@@ -171,7 +171,8 @@ def _pull_rig(tmp: Path, name: str) -> str:
 def _decompile_rig(tmp: Path, name: str) -> str:
     with _chain() as server:
         _flashed_by_an_old_mercmac(server, tmp, name)
-        return _output("decompile", "--port", server.path, "--rig", tmp / "pulled", *FAST)
+        return _output("decompile", "--port", _port(tmp, server, name), "--rig", tmp / "pulled",
+                       *FAST)
 
 
 def _history(tmp: Path, name: str) -> str:
@@ -204,10 +205,10 @@ def _sim_scenario(tmp: Path, name: str) -> str:
     return _output("sim", EXAMPLE4, "--scenario", scenario)
 
 
-SURFACES = {"sim": _sim, "sim --scenario": _sim_scenario, "describe text": _describe_text, "describe markdown": _describe_markdown,
-            "describe --graph dot": _describe_graph, "flash": _flash,
-            "flash --dry-run": _flash_dry_run, "flash FILE": _flash_file, "pull -o": _pull_file,
-            "pull --rig": _pull_rig,
+SURFACES = {"sim": _sim, "sim --scenario": _sim_scenario, "describe text": _describe_text,
+            "describe markdown": _describe_markdown, "describe --graph dot": _describe_graph,
+            "flash": _flash, "flash --dry-run": _flash_dry_run, "flash FILE": _flash_file,
+            "pull -o": _pull_file, "pull --rig": _pull_rig,
             "decompile --port --rig": _decompile_rig, "history": _history}
 _PLAIN: dict[str, str] = {}  # each surface's output for the plain name, made once
 
