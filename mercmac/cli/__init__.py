@@ -136,8 +136,8 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
             try:
                 checked = _check_file(f, chosen, fixes)
             except OSError as e:
-                from mercmac.outfile import reason
                 from mercmac.names import printable
+                from mercmac.outfile import reason
 
                 say(f"cannot read {printable(f)}: {reason(e)}")
                 unreadable += 1

@@ -570,8 +570,8 @@ def emulate(target, address, addresses, rig_path, state, firmware, tm_framing, e
 
         from mercmac.emulator.virtual import Faults
         from mercmac.emulator.ptyserver import PtyServer
-        from mercmac.outfile import appending, reason
         from mercmac.names import printable
+        from mercmac.outfile import appending, reason
 
         faults = Faults(tm_framing=tm_framing, empty_slot=empty_slot, pace=pace, baud=baud)
         vc = _virtual(target.upper(), address, addresses, rig_path, firmware=firmware,

@@ -299,8 +299,8 @@ def header(run: Run) -> Line:
 
 def write_vcd_cut(path: str, limit_mb: float, cut_at: int, stream: IO[str] | None = None) -> None:
     """The warning for a VCD that stopped at its size limit (the run itself went on)."""
-    write_lines([[(f"mercmac: warning: {printable(path)} stops at {clock(cut_at)}: it reached the "
-                   f"--vcd-limit of {limit_mb:g} MB; raise --vcd-limit (0: no limit) or "
+    write_lines([[(f"mercmac: warning: {printable(path)} stops at {clock(cut_at)}: it reached "
+                   f"the --vcd-limit of {limit_mb:g} MB; raise --vcd-limit (0: no limit) or "
                    "shorten --until", "yellow")]], stream)
 
 
