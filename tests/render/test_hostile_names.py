@@ -250,6 +250,15 @@ def test_a_file_that_cannot_be_read_is_named_escaped_on_one_line(command, tmp_pa
     _assert_safe(said[1], said[0])
 
 
+def test_every_message_escapes_its_control_characters(tmp_path):
+    """Whatever a message quotes (here `fmt`'s, which names the file as given), ESC, CR and
+    bidi marks are shown escaped (cli.common.say)."""
+    hostile = HOSTILE["esc"] + HOSTILE["osc52"] + HOSTILE["cr"] + HOSTILE["bidi"]
+    result = cli("fmt", tmp_path / f"{hostile}.mcm", color=True)
+    assert result.exit_code == 2 and names.printable(hostile) in result.output
+    assert not RAW.findall(result.output)
+
+
 def test_a_port_name_adds_no_line_to_what_pull_writes(tmp_path):
     """The file's header comment names the port: a newline there would make the rest of
     the name a line of the program."""
