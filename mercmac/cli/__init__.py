@@ -136,8 +136,8 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
             try:
                 checked = _check_file(f, chosen, fixes)
             except OSError as e:
+                from mercmac.names import printable
                 from mercmac.outfile import reason
-                from mercmac.render.report import printable
 
                 say(f"cannot read {printable(f)}: {reason(e)}")
                 unreadable += 1
@@ -167,7 +167,7 @@ def _expand(arguments: tuple[str, ...]) -> tuple[list[str], int]:
     """The files the arguments name (mercmac.files); each skipped file or folder and each
     folder without .mcm files said, and counted: they make the exit code 2."""
     from mercmac.files import named_files
-    from mercmac.render.report import printable
+    from mercmac.names import printable
 
     named = named_files(arguments)
     for path, why in named.skipped:
@@ -197,7 +197,7 @@ def _check_file(path: str, chosen, fixes=None) -> list:
     for a rig file its own findings and its programs' (mercmac.rig.checks)."""
     from mercmac.compiler import checking
     from mercmac.errors import SettingsError
-    from mercmac.render.report import printable
+    from mercmac.names import printable
     from mercmac.rig import is_rig_path
 
     try:
@@ -211,7 +211,7 @@ def _check_file(path: str, chosen, fixes=None) -> list:
 def _check_rig(path: str, chosen, fixes) -> list:
     """A rig file's findings and its programs' (mercmac.rig.checks); --fix takes .mcm files."""
     from mercmac.cli.common import UsageError
-    from mercmac.render.report import printable
+    from mercmac.names import printable
     from mercmac.rig.checks import check_rig_path
 
     if fixes is not None:
@@ -356,7 +356,7 @@ def commands_command(words: tuple[str, ...], model: str | None) -> None:
         from mercmac.commands import search
         from mercmac.compiler import guesses
         from mercmac.render.commands import write_list
-        from mercmac.render.report import printable
+        from mercmac.names import printable
 
         found = search(words, model, guesses.POINTS_TO)
         # a word no description has (`sleep`): say what people mean by it

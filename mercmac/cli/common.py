@@ -88,9 +88,10 @@ def _tell(e: BaseException) -> int:
     if isinstance(e, BrokenPipeError):  # `mercmac sim ... | head`: the reader has gone, so stop quietly
         _silence_stdout()
         return EXIT_FAILED
+    from mercmac.names import printable
     from mercmac.outfile import reason
 
-    name = f"{e.filename}: " if getattr(e, "filename", None) else ""
+    name = f"{printable(str(e.filename))}: " if getattr(e, "filename", None) else ""
     say(f"{name}{reason(e)}")
     return EXIT_USAGE
 
@@ -139,6 +140,14 @@ def _silence_stdout() -> None:
 
 
 def say(message: str, hint: str | None = None) -> None:
-    click.echo(f"mercmac: {message}", err=True)
+    """The message on standard error, each of its lines escaped: a message quotes file
+    names, ports and option values, which may hold any character (mercmac/names.py)."""
+    click.echo(f"mercmac: {_escaped(message)}", err=True)
     if hint:
-        click.echo(f"  hint: {hint}", err=True)
+        click.echo(f"  hint: {_escaped(hint)}", err=True)
+
+
+def _escaped(text: str) -> str:
+    from mercmac.names import printable
+
+    return "\n".join(printable(line) for line in text.split("\n"))

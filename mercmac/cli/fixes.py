@@ -22,7 +22,7 @@ class Fixes:
     def file(self, path: str, chosen: Options) -> Findings:
         """Fix one file (show its diff) and say what changed; what `check` reports of it
         now. OSError when it cannot be read."""
-        from mercmac.render.report import printable
+        from mercmac.names import printable
 
         done = fixing.fix_file(path, chosen, write=not self.diff)
         fixed, name = done.fixed, printable("<stdin>" if path == "-" else path)

@@ -79,7 +79,7 @@ def _recorded(read: Macros, instead: str):
     said on standard error; else None (a record whose source no longer builds to it is
     said too). None for a file: it is read for what it holds, whatever was flashed."""
     from mercmac.render.history import label
-    from mercmac.render.report import printable
+    from mercmac.names import printable
 
     if read.port is None:
         return None
@@ -236,7 +236,9 @@ def describe(file, port, address, baud, timeout, fmt, graph) -> None:
             _write_graph(dot, graph, graph_kind)
         click.echo(text, nl=not text.endswith("\n"))
         if graph is not None:
-            click.echo(f"mercmac: call graph written to {graph}", err=True)
+            from mercmac.names import printable
+
+            click.echo(f"mercmac: call graph written to {printable(graph)}", err=True)
         return EXIT_OK
 
     _guarded(work)

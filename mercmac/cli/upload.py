@@ -87,11 +87,12 @@ def check_port_arg(port: str | None, option: str | None, command: str) -> str | 
 
 def _port(port: str | None, option: str | None, command: str) -> str:
     """The port to open (mercmac.upload.ports); says on stderr how it was found if not given."""
+    from mercmac.names import printable
     from mercmac.upload import ports as chooser
 
     chosen = chooser.resolve(check_port_arg(port, option, command))
     if chosen.how:
-        click.echo(f"port: {chosen.port} ({chosen.how})", err=True)
+        click.echo(f"port: {printable(chosen.port)} ({chosen.how})", err=True)
     return chosen.port
 
 
@@ -576,6 +577,7 @@ def emulate(target, address, addresses, rig_path, state, firmware, tm_framing, e
 
         from mercmac.emulator.virtual import Faults
         from mercmac.emulator.ptyserver import PtyServer
+        from mercmac.names import printable
         from mercmac.outfile import appending, reason
 
         faults = Faults(tm_framing=tm_framing, empty_slot=empty_slot, pace=pace, baud=baud)
@@ -587,9 +589,9 @@ def emulate(target, address, addresses, rig_path, state, firmware, tm_framing, e
                 server = PtyServer(vc, log)
             except OSError as e:
                 raise UsageError(f"cannot create a pseudo-terminal: {reason(e)}") from None
-            kept = f", macros kept in {state}" if state else ""
+            kept = f", macros kept in {printable(state)}" if state else ""
             paced = f", paced at {baud} baud" if pace else ""
-            logged = f", bytes logged to {log_file}" if log_file else ""
+            logged = f", bytes logged to {printable(log_file)}" if log_file else ""
             click.echo(f"{_served(vc, firmware)}{kept}{paced}{logged}")
             click.echo(server.path)
             try:

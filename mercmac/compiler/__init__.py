@@ -80,10 +80,11 @@ def compile_file(path: str, target: str | None = None) -> Compilation:
     """Read and compile a file; an unreadable one is an InputError (exit 2), worded as
     `check` words it: "cannot read FILE: reason"."""
     from mercmac.errors import InputError
+    from mercmac.names import printable
     from mercmac.outfile import reason
 
     try:
         source = read_source(path)
     except OSError as e:
-        raise InputError(f"cannot read {path}: {reason(e)}") from None
+        raise InputError(f"cannot read {printable(path)}: {reason(e)}") from None
     return compile_source(source, target)

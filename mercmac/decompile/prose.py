@@ -3,10 +3,10 @@ describes its examples, grouped as a person reads a program."""
 from __future__ import annotations
 
 import json
-import re
 
 from mercmac.commands import C663, Mnemonic, lookup
 from mercmac.mdtext import slot_name
+from mercmac.names import dot, markdown, mermaid, printable
 from mercmac.render.sim import plural
 from mercmac.timespec import format_span
 from mercmac.decompile.lines import (Line, condition_run, every_period, model_of, names,
@@ -270,7 +270,7 @@ def describe(macros: dict[int, str], *, model: str | None = None, fmt: str = "te
         raise ValueError(f"unknown format {fmt!r}: text, markdown or json")
     md = fmt == "markdown"
     title, section = "#" * level, "#" * (level + 1)
-    out = [f"{title} {inline(_title(reader, data))}" if md else _title(reader, data)]
+    out = [f"{title} {markdown(_title(reader, data))}" if md else _title(reader, data)]
     for head, items in _sections(reader, data):
         if not items:
             continue
@@ -290,21 +290,11 @@ def described(macros: dict[int, str], *, model: str | None = None,
 
 def _item(depth: int, text: str, md: bool) -> str:
     """One item of a section; a nested one under the item before it. In markdown a nested
-    item starts at its parent's text (CommonMark §5.2: four spaces more make a code block)."""
+    item starts at its parent's text (CommonMark §5.2: four spaces more make a code block).
+    A raw line read from a controller may hold any byte: shown escaped, as a name is."""
     if md:
-        return "  " * depth + "- " + inline(text)
-    return "  " + "    " * depth + text
-
-
-# What CommonMark would read as markup in our text (§2.4 backslash escapes): code spans,
-# emphasis (`_` only at the edge of a word: inside one it is a letter, §6.2), links,
-# HTML and entities. Names and raw lines may hold any of them.
-_MARKUP = re.compile(r"[\\`*\[\]<>&]|(?<!\w)_|_(?!\w)")
-
-
-def inline(text: str) -> str:
-    """`text` as markdown shows it literally."""
-    return _MARKUP.sub(lambda m: "\\" + m.group(), text)
+        return "  " * depth + "- " + markdown(text)
+    return "  " + "    " * depth + printable(text)
 
 
 def _title(reader: Reader, data: dict) -> str:
@@ -377,7 +367,7 @@ def mermaid_body(reader: Reader, prefix: str = "", indent: str = "    ") -> list
     """The call graph's nodes and edges as mermaid lines, node ids `prefix` + 'MCnn'."""
     out = []
     for s in reader.lines:
-        out.append(f'{indent}{prefix}{slot_name(s)}["{_node(reader, s)}"]')
+        out.append(f'{indent}{prefix}{slot_name(s)}["{mermaid(_node(reader, s))}"]')
     for s, t, label, tail in _edges(reader):
         out.append(f"{indent}{prefix}{slot_name(s)} {'-.->' if tail else '-->'}|{label}| "
                    f"{prefix}{slot_name(t)}")
@@ -399,9 +389,9 @@ def dot_body(reader: Reader, prefix: str = "", indent: str = "    ") -> list[str
     out = []
     for s in reader.lines:
         out.append(f'{indent}{prefix}{slot_name(s)} '
-                   f'[label="{_node(reader, s).replace(" ", chr(92) + "n", 1)}"];')
+                   f'[label="{dot(_node(reader, s)).replace(" ", chr(92) + "n", 1)}"];')
     for s, t, label, tail in _edges(reader):
         style = ", style=dashed" if tail else ""
         out.append(f'{indent}{prefix}{slot_name(s)} -> {prefix}{slot_name(t)} '
-                   f'[label="{label}"{style}];')
+                   f'[label="{dot(label)}"{style}];')
     return out

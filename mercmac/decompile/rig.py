@@ -11,7 +11,8 @@ from typing import Mapping, NamedTuple
 
 from mercmac.commands import Mnemonic
 from mercmac.mdtext import slot_name
-from mercmac.decompile.prose import Reader, describe, described, dot_body, inline, mermaid_body
+from mercmac.decompile.prose import Reader, describe, described, dot_body, mermaid_body
+from mercmac.names import dot, markdown, mermaid, printable
 from mercmac.render.sim import plural
 
 # What a command does to the line it names (§6.4: CN/CF/CP set outputs 1-4; WN/WF wait on
@@ -83,25 +84,26 @@ def _heading(controller) -> str:
 
 
 def _text(rig, programs, readers) -> str:
-    out = [_title(rig)]
+    out = [printable(_title(rig))]
     for c in rig.controllers:
         program = _described_as(programs[c.name], "text")
-        out += ["", f"{_heading(c)}:"] + [f"  {line}" if line else "" for line in
-                                          program.rstrip("\n").split("\n")]
+        out += ["", f"{printable(_heading(c))}:"] + [f"  {line}" if line else "" for line in
+                                                     program.rstrip("\n").split("\n")]
     for head, items in _rig_sections(rig, readers):
         if items:
-            out += ["", f"{head}:"] + [f"  {'    ' * depth}{text}" for depth, text in items]
+            out += ["", f"{head}:"] + [f"  {'    ' * depth}{printable(text)}"
+                                       for depth, text in items]
     return "\n".join(out) + "\n"
 
 
 def _markdown(rig, programs, readers) -> str:
-    out = [f"# {inline(_title(rig))}"]
+    out = [f"# {markdown(_title(rig))}"]
     for c in rig.controllers:
-        out += ["", f"## {inline(_heading(c))}", "",
+        out += ["", f"## {markdown(_heading(c))}", "",
                 _described_as(programs[c.name], "markdown", level=3).rstrip("\n")]
     for head, items in _rig_sections(rig, readers):
         if items:
-            out += ["", f"## {head}", ""] + [f"{'  ' * depth}- {inline(text)}"
+            out += ["", f"## {head}", ""] + [f"{'  ' * depth}- {markdown(text)}"
                                              for depth, text in items]
     out += ["", "## Call graph", "", "```mermaid", _mermaid(rig, readers), "```"]
     return "\n".join(out) + "\n"
@@ -186,14 +188,14 @@ def rig_graph_dot(rig, programs: Mapping[str, Stored]) -> str:
            "    edge [fontsize=10];"]
     for c in rig.controllers:
         out += [f"    subgraph cluster_{c.name} {{",
-                f'        label="{_dot_text(_heading(c))}";',
+                f'        label="{dot(_heading(c))}";',
                 *dot_body(readers[c.name], prefix=f"{c.name}_", indent="        "),
                 *[f'        {_line_id(line)} [label="{line.kind}{line.number}", shape=cds];'
                   for line in _wired_lines(rig, c.name)],
                 "    }"]
     for start, end, label, wire in _wire_edges(rig, readers):
         style = "style=bold, color=blue" if wire else "style=dotted"
-        out.append(f'    {start} -> {end} [label="{_dot_text(label)}", {style}];')
+        out.append(f'    {start} -> {end} [label="{dot(label)}", {style}];')
     out.append("}")
     return "\n".join(out) + "\n"
 
@@ -201,7 +203,9 @@ def rig_graph_dot(rig, programs: Mapping[str, Stored]) -> str:
 def _mermaid(rig, readers) -> str:
     out = ["graph LR"]
     for c in rig.controllers:
-        out += [f'    subgraph {c.name}["{_heading(c)}"]',
+        # `end` and mermaid's other keywords are good controller names but no subgraph ids;
+        # `_rig` is no end of a node id (`x_MC01`, `x_out1`)
+        out += [f'    subgraph {c.name}_rig["{mermaid(_heading(c))}"]',
                 *mermaid_body(readers[c.name], prefix=f"{c.name}_", indent="        "),
                 *[f'        {_line_id(line)}>"{line.kind}{line.number}"]'
                   for line in _wired_lines(rig, c.name)],
@@ -236,7 +240,3 @@ def _wired_lines(rig, controller: str) -> list:
 
 def _line_id(line) -> str:
     return f"{line.controller}_{line.kind}{line.number}"
-
-
-def _dot_text(text: str) -> str:
-    return text.replace("\\", "\\\\").replace('"', '\\"')

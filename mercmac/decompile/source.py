@@ -20,7 +20,7 @@ from mercmac.decompile.lines import (CONDITIONS, Line, condition_run, every_peri
 from mercmac.diagnostics import Severity
 from mercmac.fmt import printer
 from mercmac.fmt.printer import Comment, Commented, RawText, Run
-from mercmac.render.report import printable
+from mercmac.names import printable
 
 RAW, NATIVE, PLAIN, FOLD = 0, 1, 2, 3  # how richly a slot is written
 # How deep folded blocks may nest. The compiler lowers a hoisted block that calls on twice

@@ -5,8 +5,8 @@ from __future__ import annotations
 from mercmac import diagnostics
 from mercmac.diagnostics import Rule
 from mercmac.errors import InputError
+from mercmac.names import printable
 from mercmac.render.console import Line, write_lines
-from mercmac.render.report import printable
 from mercmac.vm import hazards
 
 _SEVERITY_STYLE = {"error": "bold red", "warning": "bold yellow", "info": "bold cyan"}

@@ -1,12 +1,12 @@
 """`mercmac history` as a table for people or JSON for programs, and what `pull` and
 `decompile` say about a record. Every text a record holds is escaped as `check` escapes
-file names (report.printable): a name with a newline or an ESC sequence stays one cell."""
+file names (names.printable): a name with a newline or an ESC sequence stays one cell."""
 from __future__ import annotations
 
 import json
 
+from mercmac.names import printable
 from mercmac.render.console import Line
-from mercmac.render.report import printable
 
 COLUMNS = ("time", "port", "address", "model", "firmware", "file", "macros")
 

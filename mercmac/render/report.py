@@ -6,6 +6,7 @@ import sys
 from typing import IO, Iterable
 
 from mercmac.diagnostics import Diagnostic, Severity
+from mercmac.names import SURROGATES, printable
 from mercmac.render.console import Line, Piece, use_colour, write_lines
 from mercmac.source import Source
 
@@ -18,23 +19,6 @@ WINDOW = 100
 # the first ones helps a person; a program gets as many as `sim --format json` gives events.
 MAX_TEXT = 200
 MAX_JSON = 10_000
-# Characters that would act on the terminal or hide text: C0/C1 controls, DEL, line and
-# paragraph separators, zero-width and bidirectional marks ("Trojan Source").
-_HIDDEN = {c: f"\\x{c:02x}" for c in (*range(0x20), *range(0x7F, 0xA0))}
-_HIDDEN |= {c: f"\\u{c:04x}" for c in (0x2028, 0x2029, *range(0x200B, 0x2010),
-                                         *range(0x202A, 0x202F), *range(0x2066, 0x206A), 0xFEFF)}
-_HIDDEN[0x09] = " "  # a tab shows as one space, so the caret stays under its column
-# A file name that is not UTF-8 holds its bytes as lone surrogates (os.fsdecode's
-# surrogateescape, U+DC80-U+DCFF for bytes 0x80-0xFF): shown as the byte, `\xff`; no
-# stream can write a lone surrogate as UTF-8 (issue 20).
-_SURROGATES = {c: f"\\u{c:04x}" for c in range(0xD800, 0xE000)}
-_SURROGATES |= {0xDC00 + b: f"\\x{b:02x}" for b in range(0x80, 0x100)}
-_HIDDEN |= _SURROGATES
-
-
-def printable(text: str) -> str:
-    """`text` with control and invisible characters escaped (`\\x1b`), safe for a terminal."""
-    return text.translate(_HIDDEN)
 
 
 def diagnostic_lines(d: Diagnostic, source: Source | None, *, colour: bool = False) -> list[Line]:
@@ -232,7 +216,7 @@ def to_github(diagnostics: Iterable[Diagnostic], limit: int = MAX_JSON) -> str:
 def _github_file(file: str) -> str:
     """A path as the repository names it; a byte that is not UTF-8 as `\\xff`, the one
     thing a workflow command cannot carry (issue 20)."""
-    return file.replace("\\", "/").translate(_SURROGATES)
+    return file.replace("\\", "/").translate(SURROGATES)
 
 
 _SARIF_LEVEL = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}

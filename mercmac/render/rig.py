@@ -13,6 +13,7 @@ import json
 from itertools import islice
 from typing import IO, Iterator
 
+from mercmac.names import printable
 from mercmac.render import jsontext
 from mercmac.render import sim as one
 from mercmac.render.console import Line, write_lines
@@ -33,7 +34,9 @@ def header(result: RigRun) -> Line:
     until = format_span(result.until_ms * 1000, digits=None)
     names = ", ".join(f"{c.name} ({c.model}, address {c.address})"
                       for c in result.rig.controllers)
-    return [(f"Simulating rig {result.rig.name}: {names}; from power-on until {until}", "bold")]
+    # the rig's name may come from its file's name: any characters (controllers' are words)
+    return [(f"Simulating rig {printable(result.rig.name)}: {names}; from power-on until {until}",
+             "bold")]
 
 
 def timeline(result: RigRun, level: int = 0) -> list[Line]:

@@ -7,6 +7,7 @@ from itertools import islice
 from typing import IO, Iterator
 
 from mercmac.mdtext import slot_name
+from mercmac.names import printable
 from mercmac.render import jsontext
 from mercmac.render.console import Line, write_lines
 from mercmac.timespec import format_clock, format_span
@@ -298,14 +299,15 @@ def header(run: Run) -> Line:
 
 def write_vcd_cut(path: str, limit_mb: float, cut_at: int, stream: IO[str] | None = None) -> None:
     """The warning for a VCD that stopped at its size limit (the run itself went on)."""
-    write_lines([[(f"mercmac: warning: {path} stops at {clock(cut_at)}: it reached the "
-                   f"--vcd-limit of {limit_mb:g} MB; raise --vcd-limit (0: no limit) or "
+    write_lines([[(f"mercmac: warning: {printable(path)} stops at {clock(cut_at)}: it reached "
+                   f"the --vcd-limit of {limit_mb:g} MB; raise --vcd-limit (0: no limit) or "
                    "shorten --until", "yellow")]], stream)
 
 
 def write_scenario_passed(path: str, checked: int, stream: IO[str] | None = None) -> None:
     """The closing line of a scenario run in which every expectation held."""
-    write_lines([[(f"scenario {path}: all {checked} expectations met", "bold green")]], stream)
+    write_lines([[(f"scenario {printable(path)}: all {checked} expectations met", "bold green")]],
+                stream)
 
 
 def to_json(run: Run) -> str:

@@ -10,6 +10,7 @@ import sys
 from typing import IO
 
 from mercmac.mdtext import slot_name
+from mercmac.names import printable
 from mercmac.render.console import Line, rich_console, table, use_colour, write_lines
 from mercmac.render.sim import plural
 from mercmac.timespec import format_clock
@@ -29,10 +30,11 @@ def identity_lines(port: str, address: int, identity, warning: str | None = None
                    searched: bool = False, name: str = "controller") -> list[Line]:
     """'C-863, firmware 2.30, at address 0 on /dev/ttyUSB0' and what we had to do;
     `searched`: no --address was given and the address was found by a search; `name`: the
-    controller's name in a rig."""
+    controller's name in a rig. The port, like every name from outside, is shown escaped
+    (mercmac/names.py): it may hold any character."""
     v = identity.version
     lines: list[Line] = [[(f"{name}: ", "bold"), (f"{v.name}, firmware {v.firmware}", "cyan"),
-                          (f", at address {address} on {port}", "")]]
+                          (f", at address {address} on {printable(port)}", "")]]
     if searched:
         lines.append([("note: ", "bold"), (f"no --address given and nothing at 0: address {address} "
                                            f"is the only one that answers", "")])
@@ -141,7 +143,8 @@ def _event_line(event: Event) -> Line:
         case EventKind.VERIFIED:
             return [(f"[{event.done}/{event.total}] ", "dim"), (event.text, "")]
         case EventKind.BACKUP:
-            return [(f"backup of {plural(event.done, 'stored macro')}: {event.text}", "bold")]
+            return [(f"backup of {plural(event.done, 'stored macro')}: {printable(event.text)}",
+                     "bold")]
         case EventKind.RETRY | EventKind.REPAIR:
             return [(event.text, "bold yellow")]
         case _:
@@ -169,7 +172,7 @@ def flash_summary(result, port: str) -> list[Line]:
     if result.retried or result.repaired:
         again = ", ".join(slot_name(s) for s in result.retried + result.repaired)
         lines.append([("note: ", "bold yellow"), (f"needed a second write: {again} (check the cable)", "")])
-    lines.append([("backup: ", "bold"), (str(result.backup), "")])
+    lines.append([("backup: ", "bold"), (printable(str(result.backup)), "")])
     lines += _kept_note(result)
     if result.reset:
         lines.append([("reset: ", "bold"), ("RT sent, macro 0 is starting", "")])
@@ -210,7 +213,8 @@ def completed_text(result) -> str:
     if result.dry_run:
         return f"dry run complete, nothing was written; {_would(result.plan)}"
     reset = "; RT was sent, macro 0 is starting" if result.reset else ""
-    return f"the flash had finished: {_outcome(result.plan)}{reset}\n  backup: {result.backup}"
+    return (f"the flash had finished: {_outcome(result.plan)}{reset}\n"
+            f"  backup: {printable(str(result.backup))}")
 
 
 def _outcome(plan) -> str:
@@ -258,29 +262,33 @@ def wire_lines(wire: list[tuple[bytes, str]], baud: int) -> list[Line]:
 
 def pulled_lines(pulled, port: str, address: int, output: str | None) -> list[Line]:
     v = pulled.identity.version
-    where = f" into {output}" if output else ""
+    where = f" into {printable(output)}" if output else ""
     return [[("read ", ""), (plural(len(pulled.macros), "macro"), "bold"),
-             (f" from the {v.name} (firmware {v.firmware}) at address {address} on {port}{where}", "")]]
+             (f" from the {v.name} (firmware {v.firmware}) at address {address} on "
+              f"{printable(port)}{where}", "")]]
 
 
 def scan_lines(found, port: str) -> list[Line]:
     if not found:
-        return [[("no controller answered", "bold yellow"), (f" on {port} at addresses 0-15", "")]]
+        return [[("no controller answered", "bold yellow"),
+                 (f" on {printable(port)} at addresses 0-15", "")]]
     rows = [(str(f.address), f.model, f.version.firmware if f.version else "?", f.note)
             for f in found]
     lines = table(("address", "model", "firmware", "note"), rows)
     if not any(f.status for f in found):
         lines.append([("no controller answered like a Mercury", "bold yellow"),
-                      (f" on {port}: garbled replies come from a baud rate other than the "
-                       f"controllers' (check --baud)", "")])
+                      (f" on {printable(port)}: garbled replies come from a baud rate other "
+                       f"than the controllers' (check --baud)", "")])
     return lines
 
 
 def ports_lines(ports) -> list[Line]:
     if not ports:
         return [[("no serial ports found", "bold yellow")]]
-    rows = [(p.device, f"{p.vid:04X}:{p.pid:04X}" if p.vid is not None else "-",
-             p.description, f"likely Mercury ({p.mercury})" if p.mercury else "") for p in ports]
+    # the device's name and description come from the system and the USB device itself
+    rows = [(printable(p.device), f"{p.vid:04X}:{p.pid:04X}" if p.vid is not None else "-",
+             printable(p.description), f"likely Mercury ({p.mercury})" if p.mercury else "")
+            for p in ports]
     return table(("port", "usb id", "description", ""), rows,
                  style_of=lambda row: "bold green" if row[3] else "")
 
@@ -305,23 +313,25 @@ def rig_summary(result, port: str) -> list[Line]:
     """A row per controller of the rig, and the outcome line."""
     import os
 
-    rows = [(p.name, str(p.member.address), p.member.model, os.path.basename(p.member.program),
-             _rig_cell(p, result.dry_run), str(p.result.backup) if p.result and p.result.backup
-             else "-") for p in result.parts]
+    rows = [(p.name, str(p.member.address), p.member.model,
+             printable(os.path.basename(p.member.program)), _rig_cell(p, result.dry_run),
+             printable(str(p.result.backup)) if p.result and p.result.backup else "-")
+            for p in result.parts]
+    rig = printable(result.rig.name)
     lines = table(("controller", "address", "model", "program", "a flash" if result.dry_run
                    else "result", "backup"), rows, style_of=_rig_style)
     chosen = [p for p in result.parts if p.result]
-    which = (f"every controller of {result.rig.name}" if len(chosen) == len(result.parts)
+    which = (f"every controller of {rig}" if len(chosen) == len(result.parts)
              else f"each of the {plural(len(chosen), 'chosen controller')}")
     if result.dry_run:
         lines.append([("dry run: ", "bold yellow"), (f"nothing written to "
                                                      f"{plural(len(chosen), 'controller')} of "
-                                                     f"{result.rig.name}", "")])
+                                                     f"{rig}", "")])
     elif result.changes_nothing:
         lines.append([("ok: ", "bold green"), (f"nothing to write: {which} already holds its "
                                                f"program", "")])
     else:
-        lines.append([("ok: ", "bold green"), (f"{result.rig.name} on {port}: "
+        lines.append([("ok: ", "bold green"), (f"{rig} on {printable(port)}: "
                                                f"{plural(len(chosen), 'controller')} verified", "")])
     lines += [[("warning: ", "bold yellow"), (f"{p.name}: the flash could not be recorded in the "
                                               f"history ({p.result.unrecorded})", "")]
@@ -359,6 +369,7 @@ def pulled_rig_lines(members, port: str, rig_file, how: list[str]) -> list[Line]
     rows = [(m.name, str(m.address), m.pulled.identity.version.name,
              plural(len(m.pulled.macros), "macro"), made) for m, made in zip(members, how)]
     lines = table(("controller", "address", "model", "holds", "written as"), rows)
-    lines.append([("rig: ", "bold"), (f"{rig_file} ({plural(len(members), 'controller')} on "
-                                      f"{port}; wires cannot be read: add them)", "")])
+    lines.append([("rig: ", "bold"), (f"{printable(str(rig_file))} ("
+                                      f"{plural(len(members), 'controller')} on "
+                                      f"{printable(port)}; wires cannot be read: add them)", "")])
     return lines

@@ -34,7 +34,7 @@ class RigRefused(MercmacError):
     as `check` reports them); nothing may run. Exit 1, as `sim FILE` with errors."""
 
     def __init__(self, path: str, findings: list[Findings]):
-        from mercmac.render.report import printable
+        from mercmac.names import printable
 
         super().__init__(f"{printable(path)} has errors",
                          hint=f"`mercmac check {printable(path)}` lists them")
@@ -46,7 +46,7 @@ class ProgramsUnread(RigRefused, InputError):
     that takes the rig, as an unreadable file is (rig.checks.unreadable_programs)."""
 
     def __init__(self, path: str, findings: list[Findings]):
-        from mercmac.render.report import printable
+        from mercmac.names import printable
 
         super().__init__(path, findings)
         self.message = f"a program of {printable(path)} cannot be read"
@@ -56,7 +56,7 @@ def read(path: str) -> RigFile:
     """The rig file at `path` as read (its own diagnostics in it); InputError (exit 2), worded
     as `check` words it, when it cannot be read."""
     from mercmac.outfile import reason
-    from mercmac.render.report import printable
+    from mercmac.names import printable
 
     try:
         return read_rig(path)

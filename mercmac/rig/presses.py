@@ -20,7 +20,7 @@ def refusal(rig: Rig, controller: str, number: int) -> str | None:
     if number in JOYSTICK_INPUTS:
         return _joystick(rig, controller, number)
     if rig.box is None:
-        return (f"buttons 1-4 are the C-170.PB box's, and the rig has no box: box = \"NAME\" "
+        return ("buttons 1-4 are the C-170.PB box's, and the rig has no box: box = \"NAME\" "
                 "in the rig file names the controller it is plugged into")
     if controller != rig.box:
         return f"the box is plugged into {rig.box} (box = \"{rig.box}\"), not into {controller}"

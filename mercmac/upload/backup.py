@@ -12,6 +12,7 @@ from pathlib import Path
 
 from mercmac import __version__, outfile
 from mercmac.mdtext import slot_name
+from mercmac.names import printable
 from mercmac.upload.protocol import Version
 
 
@@ -28,14 +29,16 @@ class BackupError(Exception):
 
 def to_mcm(macros: dict[int, str], version: Version, *, port: str, address: int,
            when: _dt.datetime | None = None) -> str:
-    """The .mcm text: a header comment, `target`, then one `[MCnn]` line per stored slot."""
+    """The .mcm text: a header comment, `target`, then one `[MCnn]` line per stored slot.
+    The port and VE's text are escaped (mercmac.names): a newline in a port's name would end
+    the comment, and what follows it would be read as lines of the program."""
     when = when or _dt.datetime.now().astimezone()
     head = [
         "// Mercury(TM) Macro File",
-        f"// read by mercmac {__version__} from {port}, address {address}, "
+        f"// read by mercmac {__version__} from {printable(port)}, address {address}, "
         f"on {when.isoformat(timespec='seconds')}",
         f"// controller: {version.name}, firmware {version.firmware}",
-        f"// VE: {_comment_safe(version.text)}",
+        f"// VE: {printable(version.text)}",
         f"// {len(macros)} macro{'s' if len(macros) != 1 else ''} stored",
         f"target {version.model}" if version.model else "// no `target`: VE names no known model",
         "",
@@ -108,6 +111,3 @@ def _port_tag(port: str) -> str:
     tail = re.sub(r"^(/dev/|\\\\\.\\)", "", tail)
     return re.sub(r"[^A-Za-z0-9_.]+", "-", tail).strip("-") or "port"
 
-
-def _comment_safe(text: str) -> str:
-    return "".join(c if c.isprintable() else "?" for c in text)

@@ -409,14 +409,16 @@ def name_from(text: str) -> str:
 
 def rig_text(name: str, members: list[Pulled], port: str) -> str:
     """A rig file for the pulled controllers (keys as mercmac.rig.load reads them); what a
-    controller cannot tell (wires, box, joystick) is said in a comment."""
+    controller cannot tell (wires, box, joystick) is said in a comment, the port escaped
+    (TOML refuses control characters in a comment, and a newline would end it)."""
     import datetime as _dt
     import json
 
     from mercmac import __version__
+    from mercmac.names import printable
 
     when = _dt.datetime.now().astimezone().isoformat(timespec="seconds")
-    head = [f"# read by mercmac {__version__} from {_comment(port)} on {when}: the "
+    head = [f"# read by mercmac {__version__} from {printable(port)} on {when}: the "
             f"controllers that answered a scan",
             "# Wires cannot be read from controllers (nor which one has the C-170.PB box,",
             "# nor the joystick's branches): add them, e.g. wires = [\"x.out1 -> y.in1\"]",
@@ -427,7 +429,3 @@ def rig_text(name: str, members: list[Pulled], port: str) -> str:
         head += ["", f"[controllers.{m.name}]", f"address = {m.address}", f"model = {model}",
                  f"program = {json.dumps(m.name + '.mcm')}"]
     return "\n".join(head) + "\n"
-
-
-def _comment(text: str) -> str:
-    return "".join(c if c.isprintable() else "?" for c in text)

@@ -113,7 +113,7 @@ def test_markdown_nests_the_programs_and_draws_one_graph(rig):
     assert "\n### 2 macros for a C-663" in text and "\n#### Every macro\n" in text
     assert "\n## Wires\n" in text and "\n  - set by x's sweep (MC01): turns it on, then" in text
     graph = text.split("\n## Call graph\n\n```mermaid\n")[1]
-    assert 'subgraph x["x, address 0, C-663: x.mcm"]' in graph
+    assert 'subgraph x_rig["x, address 0, C-663: x.mcm"]' in graph
     assert "x_out1 ==>|x.out1 to y.in1| y_in1" in graph
     assert "y_in1 -.->|waits until it is on| y_MC01" in graph
 

@@ -19,8 +19,8 @@ from helpers.paths import FOUR_MODES, PACKAGE, ROOT
 # Modules every layer may use: they import none of the subpackages (mercmac.ops names the Op
 # that mdtext reads and the compiler lowers to: neither imports the other for it, issue 17).
 FOUNDATION = {"mercmac", "mercmac.__version__", "mercmac.commands", "mercmac.diagnostics",
-              "mercmac.errors", "mercmac.mdtext", "mercmac.ops", "mercmac.outfile",
-              "mercmac.source", "mercmac.timespec"}
+              "mercmac.errors", "mercmac.mdtext", "mercmac.names", "mercmac.ops",
+              "mercmac.outfile", "mercmac.source", "mercmac.timespec"}
 
 # layer -> the layers it must never import
 FORBIDDEN = {
