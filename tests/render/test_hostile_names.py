@@ -187,12 +187,12 @@ def _sim(tmp: Path, name: str) -> str:
     """`sim RIG`'s text for a rig of that name: a rig's name defaults to its file's, and the
     header shows it (its controllers' names are words: the rig reader refuses others)."""
     from mercmac.render import rig as render
-    from mercmac.rig.checks import compile_rig
-    from mercmac.rig.load import read_rig
+    from mercmac.rig.accept import accept
     from mercmac.sim.rig import simulate_rig
 
-    rig = replace(read_rig(str(_rig(tmp / "rig", "x"))).rig, name=name)
-    programs = {n: c.program for n, c in compile_rig(rig).items()}
+    accepted = accept(str(_rig(tmp / "rig", "x")))
+    rig = replace(accepted.rig, name=name)
+    programs = {n: c.program for n, c in accepted.programs.items()}
     shown = io.StringIO()
     render.write_text(simulate_rig(rig, programs, until_ms=50), shown)
     return shown.getvalue()
