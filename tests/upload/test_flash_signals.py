@@ -1,0 +1,115 @@
+"""SIGTERM and SIGHUP while `flash` writes are answered as Ctrl-C is (SPEC §5, issue 25 item 4):
+what each controller holds, where its backup is, exit 128+N; and the backup puts it back.
+
+Each flash is a real process against the virtual controller (or chain) on a pty; the signal
+goes when the emulator has taken the first MD of the controller being written."""
+from __future__ import annotations
+
+import io
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from helpers.cli import cli
+from helpers.emulator import FAST, eventually, serve
+from helpers.paths import ROOT
+from mercmac.emulator.chain import Chain
+from mercmac.emulator.ptyserver import PtyServer
+from mercmac.emulator.virtual import Faults, VirtualController
+
+pytestmark = pytest.mark.skipif(not hasattr(os, "openpty") or not hasattr(signal, "SIGHUP"),
+                                reason="needs pseudo-terminals and POSIX signals")
+
+PROGRAM = "target C-863\n[MC00] EM5\n[MC05] MR5000,WS100\n[MC06] XN1,MR-10\n[MC07] TP\n"
+OLD = {0: "EM1", 1: "TP"}  # what the controller held before the flash
+SIGNALS = [signal.SIGTERM, signal.SIGHUP]
+RASTER = ROOT / "examples" / "rigs" / "raster"
+
+
+def flashing(*args: str) -> subprocess.Popen:
+    """`mercmac flash ARGS` as a process, as a user (or a supervisor) starts it."""
+    return subprocess.Popen([sys.executable, "-m", "mercmac", "flash", *args, *FAST],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def signal_once_written(proc: subprocess.Popen, server, vc, signum: int) -> tuple[str, str]:
+    """Send SIGNUM once VC has taken an MD line (the flash is writing it); the output."""
+    end = time.monotonic() + 20
+    while server.call(lambda _c: vc.md_count) < 1 and proc.poll() is None \
+            and time.monotonic() < end:
+        time.sleep(0.005)
+    assert proc.poll() is None, proc.communicate()
+    proc.send_signal(signum)
+    return proc.communicate(timeout=20)
+
+
+def settled(server, vcs) -> bool:
+    """Whether every controller has read what the stopped flash sent it: a late answer of one
+    would come amid the next flash's exchange."""
+    return eventually(server, lambda _c: not any(vc.waiting for vc in vcs), seconds=10)
+
+
+def restores(server, backup: str, address: int, old: dict[int, str], vc) -> bool:
+    """Whether flashing BACKUP with --erase-unused puts back exactly what VC held (OLD)."""
+    result = cli("flash", server.path, backup, "--address", address, "--erase-unused", *FAST)
+    assert result.exit_code == 0, result.output
+    return server.call(lambda _c: dict(vc.macros)) == old
+
+
+@pytest.mark.parametrize("signum", SIGNALS, ids=lambda s: signal.Signals(s).name)
+def test_a_signal_while_a_file_is_flashed_says_what_the_controller_holds(signum, program_file,
+                                                                         tmp_path):
+    backup = tmp_path / "b.mcm"
+    with serve(macros=dict(OLD), faults=Faults(md_delay=0.2)) as (server, vc):
+        proc = flashing(server.path, str(program_file), "--backup", str(backup))
+        out, err = signal_once_written(proc, server, vc, signum)
+        assert proc.returncode == 128 + signum, out + err
+        name = signal.Signals(signum).name
+        assert f"mercmac: flash stopped: interrupted ({name})" in err
+        assert "written and verified: MC00 (autostart removed)" in err
+        assert "in progress, state unknown: MC05" in err and "not written: MC06, MC07" in err
+        assert "macro 0: removed before the first write" in err
+        assert f"backup of the controller as it was: {backup}" in err
+        assert "Traceback" not in err and "Exception ignored" not in err
+        assert 0 not in server.call(lambda _c: dict(vc.macros))  # no half-written autostart
+        assert settled(server, [vc]) and restores(server, str(backup), 0, OLD, vc)
+
+
+@pytest.fixture
+def rig(tmp_path) -> Path:
+    """The raster example where a test may write beside it: two C-663, addresses 0 and 1."""
+    folder = tmp_path / "raster"
+    shutil.copytree(RASTER, folder)
+    return folder / "raster.rig.toml"
+
+
+@pytest.mark.parametrize("signum", SIGNALS, ids=lambda s: signal.Signals(s).name)
+def test_a_signal_while_a_rig_is_flashed_says_what_each_controller_holds(signum, rig, data_dir):
+    old = [{0: "EM1", 1: "TP"}, {0: "EM2", 2: "TP"}]
+    vcs = [VirtualController("C-663", 0, macros=dict(old[0])),
+           VirtualController("C-663", 1, macros=dict(old[1]), faults=Faults(md_delay=0.2))]
+    with PtyServer(Chain(vcs), io.StringIO()) as server:
+        proc = flashing(server.path, str(rig))
+        out, err = signal_once_written(proc, server, vcs[1], signum)  # x is done, y is begun
+        assert proc.returncode == 128 + signum, out + err
+        assert "Traceback" not in err and "Exception ignored" not in err
+        name = signal.Signals(signum).name
+        assert f"rig flash stopped at y (address 1): flash stopped: interrupted ({name})" in err
+        held = dict(re.findall(r"^  (\w) \(address \d\): (.*)$", err, re.M))
+        assert held["x"].startswith("flashed and verified; backup of what it held: ")
+        assert held["y"].startswith("partly written; backup of what it held: ")
+        backups = {n: state.split("backup of what it held: ")[1] for n, state in held.items()}
+        assert f"backup of the controller as it was: {backups['y']}" in err
+        assert f"`mercmac flash {server.path} {backups['y']} --address 1 --erase-unused` puts " \
+               "the old program back" in err  # y's backup goes back to y, not to x at 0
+        assert 0 not in server.call(lambda _c: dict(vcs[1].macros))
+        assert settled(server, vcs)
+        for address, (n, vc) in enumerate(zip("xy", vcs)):
+            assert restores(server, backups[n], address, old[address], vc), n
