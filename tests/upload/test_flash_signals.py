@@ -8,6 +8,7 @@ from __future__ import annotations
 import io
 import os
 import re
+import select
 import shutil
 import signal
 import subprocess
@@ -113,3 +114,43 @@ def test_a_signal_while_a_rig_is_flashed_says_what_each_controller_holds(signum,
         assert settled(server, vcs)
         for address, (n, vc) in enumerate(zip("xy", vcs)):
             assert restores(server, backups[n], address, old[address], vc), n
+
+
+def on_a_terminal(slave: int):
+    """preexec_fn: the child leads a session whose controlling terminal is SLAVE, so that
+    closing the other end hangs it up and the kernel sends the child SIGHUP (as ssh does)."""
+    def become() -> None:
+        import fcntl  # POSIX only, as this module is
+        import termios
+
+        os.setsid()
+        fcntl.ioctl(slave, termios.TIOCSCTTY, 0)
+    return become
+
+
+def test_a_terminal_that_hangs_up_while_flashing_gets_the_report_where_stderr_goes(
+        program_file, tmp_path):
+    """The progress bar's terminal is gone (writes fail, SIGHUP comes): the report still goes
+    to standard error (here a file, as `2>flash.log`), exit 129, no half-written autostart."""
+    import pty  # POSIX only, as this module is
+
+    backup, log = tmp_path / "b.mcm", tmp_path / "flash.log"
+    with serve(macros=dict(OLD), faults=Faults(md_delay=0.2)) as (server, vc), \
+            open(log, "w") as err:
+        master, slave = pty.openpty()
+        proc = subprocess.Popen([sys.executable, "-m", "mercmac", "flash", server.path,
+                                 str(program_file), "--backup", str(backup), *FAST],
+                                stdin=slave, stdout=slave, stderr=err,
+                                preexec_fn=on_a_terminal(slave))
+        os.close(slave)
+        end = time.monotonic() + 20
+        while server.call(lambda _c: vc.md_count) < 1 and time.monotonic() < end:
+            if select.select([master], [], [], 0.01)[0]:  # the bar is drawn: read it away
+                os.read(master, 65536)
+        os.close(master)  # the terminal hangs up
+        assert proc.wait(timeout=20) == 128 + signal.SIGHUP, log.read_text()
+        said = log.read_text()
+        assert "mercmac: flash stopped: interrupted (SIGHUP)" in said, said
+        assert f"backup of the controller as it was: {backup}" in said and "Traceback" not in said
+        assert 0 not in server.call(lambda _c: dict(vc.macros))
+        assert settled(server, [vc]) and restores(server, str(backup), 0, OLD, vc)
