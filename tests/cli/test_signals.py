@@ -11,12 +11,15 @@ from __future__ import annotations
 
 import os
 import re
+import select
 import signal
 import subprocess
 import sys
+import time
 
 import pytest
 
+from helpers.cli import on_a_terminal
 from helpers.files import leftovers
 from helpers.paths import EXAMPLE4, ROOT
 
@@ -126,3 +129,24 @@ def test_a_signal_during_sim_shows_the_run_so_far_and_keeps_the_old_vcd(signum, 
     assert "Traceback" not in done.stderr
     assert "power-on: MC00 starts" in done.stdout and "Summary" in done.stdout
     assert vcd.read_text() == "old\n" and leftovers(tmp_path) == []
+
+
+def test_sim_interactive_on_a_terminal_that_hangs_up_ends_with_129(tmp_path):
+    """The terminal it put in cbreak mode is gone: putting it back cannot fail the run."""
+    import pty
+
+    log = tmp_path / "err.log"
+    master, slave = pty.openpty()
+    with open(log, "w") as err:
+        proc = subprocess.Popen([sys.executable, "-m", "mercmac", "sim", str(EXAMPLE4), "--interactive"],
+                                stdin=slave, stdout=slave, stderr=err, cwd=tmp_path,
+                                env={**os.environ, "PYTHONPATH": str(ROOT), "NO_COLOR": "1"},
+                                preexec_fn=on_a_terminal(slave))
+    os.close(slave)
+    seen, end = b"", time.monotonic() + 30
+    while b"keys 1-4" not in seen and time.monotonic() < end:  # the box is up: it runs
+        if select.select([master], [], [], 0.1)[0]:
+            seen += os.read(master, 65536)
+    os.close(master)  # the terminal hangs up
+    assert proc.wait(timeout=20) == 128 + signal.SIGHUP, log.read_text()
+    assert log.read_text().splitlines() == said(signal.SIGHUP)

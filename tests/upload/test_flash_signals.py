@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers.cli import cli
+from helpers.cli import cli, on_a_terminal
 from helpers.emulator import FAST, eventually, serve
 from helpers.paths import ROOT
 from mercmac.emulator.chain import Chain
@@ -114,18 +114,6 @@ def test_a_signal_while_a_rig_is_flashed_says_what_each_controller_holds(signum,
         assert settled(server, vcs)
         for address, (n, vc) in enumerate(zip("xy", vcs)):
             assert restores(server, backups[n], address, old[address], vc), n
-
-
-def on_a_terminal(slave: int):
-    """preexec_fn: the child leads a session whose controlling terminal is SLAVE, so that
-    closing the other end hangs it up and the kernel sends the child SIGHUP (as ssh does)."""
-    def become() -> None:
-        import fcntl  # POSIX only, as this module is
-        import termios
-
-        os.setsid()
-        fcntl.ioctl(slave, termios.TIOCSCTTY, 0)
-    return become
 
 
 def test_a_terminal_that_hangs_up_while_flashing_gets_the_report_where_stderr_goes(
