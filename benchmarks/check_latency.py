@@ -36,7 +36,8 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=31)
     args = parser.parse_args()
     # what the console script runs (pyproject.toml [project.scripts]): the entry point first
-    check = [sys.executable, "-c", "from mercmac.__main__ import main; main()", "check", str(EXAMPLE)]
+    check = [sys.executable, "-c", "from mercmac.__main__ import main; main()", "check",
+             str(EXAMPLE)]
     bare = [sys.executable, "-c", "pass"]
     wall(check), wall(bare)  # warm the file cache
     checks, bares = [], []

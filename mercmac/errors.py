@@ -10,8 +10,8 @@ is the CLI's own, for options that do not go together.
                     read or written (SPEC §5: usage/IO)
     SettingsError   a rule selection, model or settings file checking      exit 2
                     cannot take (config, suppress, the editor's settings)
-    Interrupted     a signal cut the work short (Ctrl-C, SIGTERM,         exit 128+N:
-                    SIGHUP); the message says how far                      130, 143, 129
+    Interrupted     a signal cut the work short (Ctrl-C, SIGTERM or        exit 128+N
+                    SIGHUP); the message says how far                      (130, 143, 129)
 
 SIGTERM and SIGHUP reach the library as `Signalled`, a KeyboardInterrupt: whatever tidies
 up after Ctrl-C (a flash's report, a simulation cut short) does the same for them (SPEC §5).

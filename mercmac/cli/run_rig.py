@@ -12,9 +12,9 @@ import re
 import sys
 
 from mercmac.cli.common import UsageError
-from mercmac.errors import interrupt
 from mercmac.cli.run import _hazards_ok, _until  # the single controller's, alike
 from mercmac.cli.run import _hold as _held_at_power_on
+from mercmac.errors import interrupt
 from mercmac.outfile import drafting, writable_target
 from mercmac.rig.model import Rig
 from mercmac.sim.rig import Hold, RigRun, RigSim

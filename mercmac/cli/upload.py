@@ -260,8 +260,8 @@ def _reporting_completion(work, finished) -> int:
         from mercmac.render.upload import completed_text
         from mercmac.upload.errors import FlashInterrupted
 
-        raise FlashInterrupted(f"interrupted while showing the result; {completed_text(finished[0])}",
-                               by=e) from None
+        raise FlashInterrupted("interrupted while showing the result; "
+                               f"{completed_text(finished[0])}", by=e) from None
 
 
 def _watch(port: str, address: int | None, finished: list):
@@ -587,7 +587,7 @@ def emulate(target, address, addresses, rig_path, state, firmware, tm_framing, e
             click.echo(server.path)
             try:
                 server.serve_forever()
-            except KeyboardInterrupt as e:  # the only way it ends: 128+N, as `scan` and `sim -i` exit
+            except KeyboardInterrupt as e:  # the only way it ends (128+N), as `scan` and `sim -i`
                 return exit_code_for(signal_of(e))
             finally:
                 server.close()

@@ -138,7 +138,8 @@ def test_sim_interactive_on_a_terminal_that_hangs_up_ends_with_129(tmp_path):
     log = tmp_path / "err.log"
     master, slave = pty.openpty()
     with open(log, "w") as err:
-        proc = subprocess.Popen([sys.executable, "-m", "mercmac", "sim", str(EXAMPLE4), "--interactive"],
+        proc = subprocess.Popen([sys.executable, "-m", "mercmac", "sim", str(EXAMPLE4),
+                                 "--interactive"],
                                 stdin=slave, stdout=slave, stderr=err, cwd=tmp_path,
                                 env={**os.environ, "PYTHONPATH": str(ROOT), "NO_COLOR": "1"},
                                 preexec_fn=on_a_terminal(slave))
@@ -147,6 +148,7 @@ def test_sim_interactive_on_a_terminal_that_hangs_up_ends_with_129(tmp_path):
     while b"keys 1-4" not in seen and time.monotonic() < end:  # the box is up: it runs
         if select.select([master], [], [], 0.1)[0]:
             seen += os.read(master, 65536)
+    assert b"keys 1-4" in seen, seen
     os.close(master)  # the terminal hangs up
     assert proc.wait(timeout=20) == 128 + signal.SIGHUP, log.read_text()
     assert log.read_text().splitlines() == said(signal.SIGHUP)

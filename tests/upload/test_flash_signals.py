@@ -139,6 +139,7 @@ def test_a_terminal_that_hangs_up_while_flashing_gets_the_report_where_stderr_go
         assert proc.wait(timeout=20) == 128 + signal.SIGHUP, log.read_text()
         said = log.read_text()
         assert "mercmac: flash stopped: interrupted (SIGHUP)" in said, said
+        assert "in progress, state unknown: MC05" in said  # it was writing when it hung up
         assert f"backup of the controller as it was: {backup}" in said and "Traceback" not in said
         assert 0 not in server.call(lambda _c: dict(vc.macros))
         assert settled(server, [vc]) and restores(server, str(backup), 0, OLD, vc)
