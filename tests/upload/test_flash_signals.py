@@ -14,16 +14,21 @@ import signal
 import subprocess
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
 
 from helpers.cli import cli, on_a_terminal
-from helpers.emulator import FAST, eventually, serve
+from helpers.emulator import FAST, FAST_TIMING, eventually, serve
 from helpers.paths import ROOT
 from mercmac.emulator.chain import Chain
 from mercmac.emulator.ptyserver import PtyServer
 from mercmac.emulator.virtual import Faults, VirtualController
+from mercmac.errors import interrupt
+from mercmac.upload.errors import FlashInterrupted
+from mercmac.upload.flasher import Event, EventKind
+from mercmac.upload.rig import RigWatch, flash_rig
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "openpty") or not hasattr(signal, "SIGHUP"),
                                 reason="needs pseudo-terminals and POSIX signals")
@@ -31,6 +36,7 @@ pytestmark = pytest.mark.skipif(not hasattr(os, "openpty") or not hasattr(signal
 PROGRAM = "target C-863\n[MC00] EM5\n[MC05] MR5000,WS100\n[MC06] XN1,MR-10\n[MC07] TP\n"
 OLD = {0: "EM1", 1: "TP"}  # what the controller held before the flash
 SIGNALS = [signal.SIGTERM, signal.SIGHUP]
+ALIKE = [signal.SIGINT, *SIGNALS]  # Ctrl-C's KeyboardInterrupt, and Signalled for the others
 RASTER = ROOT / "examples" / "rigs" / "raster"
 
 
@@ -143,3 +149,55 @@ def test_a_terminal_that_hangs_up_while_flashing_gets_the_report_where_stderr_go
         assert f"backup of the controller as it was: {backup}" in said and "Traceback" not in said
         assert 0 not in server.call(lambda _c: dict(vc.macros))
         assert settled(server, [vc]) and restores(server, str(backup), 0, OLD, vc)
+
+
+# -- the library: a Signalled (SIGTERM, SIGHUP) wherever a KeyboardInterrupt is answered --------
+
+class SignalledAt(RigWatch):
+    """A rig flash's watch whose notify raises what SIGNUM raises in a command (mercmac.errors
+    .interrupt) at the first event of KIND, while meeting the controllers or writing them."""
+
+    def __init__(self, kind: EventKind, signum: int):
+        self.kind, self.signum = kind, signum
+
+    def _notify(self, event: Event) -> None:
+        if event.kind is self.kind:
+            raise interrupt(self.signum)
+
+    @contextmanager
+    def meeting(self, part):
+        yield self._notify
+
+    @contextmanager
+    def writing(self, part):
+        yield self._notify
+
+
+@pytest.mark.parametrize("signum", ALIKE, ids=lambda s: signal.Signals(s).name)
+def test_a_signal_while_a_rig_is_backed_up_writes_nothing_and_exits_128_plus_n(signum, rig,
+                                                                               data_dir):
+    vcs = [VirtualController("C-663", address) for address in (0, 1)]
+    with PtyServer(Chain(vcs), io.StringIO()) as server, \
+            pytest.raises(FlashInterrupted) as caught:
+        flash_rig(server.path, str(rig), timing=FAST_TIMING,
+                  watch=SignalledAt(EventKind.BACKUP, signum))
+    assert caught.value.exit_code == 128 + signum
+    assert caught.value.message.startswith("x: interrupted before the first write; nothing was "
+                                           "written; backup: ")
+    assert "x (address 0): untouched" in caught.value.message
+    assert [vc.md_count for vc in vcs] == [0, 0]
+
+
+@pytest.mark.parametrize("signum", ALIKE, ids=lambda s: signal.Signals(s).name)
+def test_a_signal_while_a_rig_is_written_names_the_signal_and_exits_128_plus_n(signum, rig,
+                                                                              data_dir):
+    vcs = [VirtualController("C-663", address) for address in (0, 1)]
+    with PtyServer(Chain(vcs), io.StringIO()) as server, \
+            pytest.raises(FlashInterrupted) as caught:
+        flash_rig(server.path, str(rig), timing=FAST_TIMING,
+                  watch=SignalledAt(EventKind.VERIFIED, signum))
+    how = "Ctrl-C" if signum == signal.SIGINT else signal.Signals(signum).name
+    assert caught.value.exit_code == 128 + signum
+    assert f"rig flash stopped at x (address 0): flash stopped: interrupted ({how})" \
+        in caught.value.message
+    assert "x (address 0): partly written; backup of what it held: " in caught.value.message
