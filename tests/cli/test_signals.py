@@ -29,14 +29,15 @@ SIGNALS = [signal.SIGINT, signal.SIGTERM, signal.SIGHUP]
 NAMES = lambda s: signal.Signals(s).name  # noqa: E731 (pytest ids)
 
 # The program as pip's console script or `python -m mercmac` starts it, with a meta path
-# finder that sends the process SIGNUM when MODULE is first imported: a signal at that point.
+# finder that sends the process SIGNUM when MODULE is first imported (then runs TELL): a
+# signal at that point.
 STARTED = """
 import os, runpy, signal, sys
 class Trip:
     def find_spec(self, name, path=None, target=None):
         if name == {module!r}:
             sys.meta_path.remove(self)
-            os.kill(os.getpid(), {signum})
+            os.kill(os.getpid(), {signum}){tell}
         return None
 sys.meta_path.insert(0, Trip())
 sys.argv = ["mercmac", *{args!r}]
@@ -91,7 +92,7 @@ MODULES = ["mercmac.cli", "click.core", "mercmac.cli.sim", "mercmac.compiler"]
 @pytest.mark.parametrize("module", MODULES)
 @pytest.mark.parametrize("signum", SIGNALS, ids=NAMES)
 def test_a_signal_while_the_program_starts_ends_it_in_one_line(module, signum, tmp_path):
-    code = STARTED.format(module=module, signum=int(signum), start=STARTS["script"],
+    code = STARTED.format(module=module, signum=int(signum), start=STARTS["script"], tell="",
                           args=["sim", str(EXAMPLE4), "--until", "1500d"])
     done = run(code, tmp_path)
     assert (done.returncode, done.stderr.splitlines()) == (128 + signum, said(signum)), \
@@ -101,7 +102,7 @@ def test_a_signal_while_the_program_starts_ends_it_in_one_line(module, signum, t
 
 @pytest.mark.parametrize("signum", SIGNALS, ids=NAMES)
 def test_python_dash_m_mercmac_is_the_same_program(signum, tmp_path):
-    code = STARTED.format(module="mercmac.cli", signum=int(signum), start=STARTS["-m"],
+    code = STARTED.format(module="mercmac.cli", signum=int(signum), start=STARTS["-m"], tell="",
                           args=["check", str(EXAMPLE4)])
     done = run(code, tmp_path)
     assert (done.returncode, done.stderr.splitlines()) == (128 + signum, said(signum)), \
@@ -110,7 +111,8 @@ def test_python_dash_m_mercmac_is_the_same_program(signum, tmp_path):
 
 def test_the_entry_point_runs_the_command_line(tmp_path):
     for start in STARTS.values():
-        code = STARTED.format(module="none", signum=0, start=start, args=["check", str(EXAMPLE4)])
+        code = STARTED.format(module="none", signum=0, start=start, tell="",
+                              args=["check", str(EXAMPLE4)])
         done = run(code, tmp_path)
         assert done.returncode == 0 and "0 errors, 3 warnings" in done.stdout, done.stderr
 
@@ -152,3 +154,15 @@ def test_sim_interactive_on_a_terminal_that_hangs_up_ends_with_129(tmp_path):
     os.close(master)  # the terminal hangs up
     assert proc.wait(timeout=20) == 128 + signal.SIGHUP, log.read_text()
     assert log.read_text().splitlines() == said(signal.SIGHUP)
+
+
+@pytest.mark.parametrize("module", ["mercmac.cli", "mercmac.compiler"])
+def test_a_signal_the_program_was_started_ignoring_stays_ignored(module, tmp_path):
+    """`nohup mercmac ...` ignores SIGHUP (and `mercmac ... &` in a script, SIGINT): the
+    command goes on to its end, from the entry point on and inside its work."""
+    ignoring = "signal.signal(signal.SIGHUP, signal.SIG_IGN); " + STARTS["script"]
+    code = STARTED.format(module=module, signum=int(signal.SIGHUP), start=ignoring,
+                          tell="; print('signalled')", args=["check", str(EXAMPLE4)])
+    done = run(code, tmp_path)
+    assert done.returncode == 0 and "0 errors, 3 warnings" in done.stdout, done.stderr
+    assert done.stdout.startswith("signalled\n")
