@@ -10,7 +10,6 @@ from __future__ import annotations
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from enum import Enum
-from functools import partial
 from pathlib import Path
 from typing import Callable, Iterator
 
@@ -285,24 +284,31 @@ class _Run:
                 self.notify(Event(EventKind.VERIFIED, f"{step.describe}: verified", i + 1, total,
                                   sent, size))
         except KeyboardInterrupt as e:  # Ctrl-C, SIGTERM or SIGHUP (mercmac.errors.Signalled)
-            kind = partial(FlashInterrupted, by=e)
-            cause, alive = f"interrupted ({how(signal_of(e))})", True
+            cause, alive, by = None, True, e
         except _Mismatch as e:
             self.verify_failed = True
-            kind, cause, alive = FlashFailed, e.args[0], True
+            cause, alive, by = e.args[0], True, None
         except ControllerError as e:
-            kind, cause, alive = FlashFailed, _cause(e), not isinstance(e, LinkLost)
+            cause, alive, by = _cause(e), not isinstance(e, LinkLost), None
         else:
             return
-        # Inline, with no call before the `try`: a second Ctrl-C, pending since the first,
+        # Inline, with no call before the `try`: a second signal, pending since the first,
         # fires at the first call and must land inside it. It skips the tidy-up, never the report.
         while True:
             try:
-                stopped = kind(self._report(cause, alive=alive), hint=self._hint())
+                stopped = self._stopped(cause, alive, by)
                 break
             except KeyboardInterrupt:
                 alive = False  # no more talking to the controller: just say where things stand
         raise stopped from None
+
+    def _stopped(self, cause: str | None, alive: bool, by: KeyboardInterrupt | None) -> FlashFailed:
+        """The error that ends the flash, with the report; FlashInterrupted when a signal BY
+        stopped it (its words, and its exit code 128+N)."""
+        if by is None:
+            return FlashFailed(self._report(cause, alive=alive), hint=self._hint())
+        cause = f"interrupted ({how(signal_of(by))})"
+        return FlashInterrupted(self._report(cause, alive=alive), hint=self._hint(), by=by)
 
     def reset(self) -> None:
         try:

@@ -89,6 +89,28 @@ def test_a_signal_while_a_file_is_flashed_says_what_the_controller_holds(signum,
         assert settled(server, [vc]) and restores(server, str(backup), 0, OLD, vc)
 
 
+@pytest.mark.parametrize("second", ALIKE, ids=lambda s: signal.Signals(s).name)
+def test_a_second_signal_at_once_keeps_the_report_of_the_first(second, program_file, tmp_path):
+    """SIGTERM, then at once another signal (a supervisor's, a closing terminal's): the second
+    may cut the tidy-up short, never the report. Two signals pending together are handled in
+    the order of their numbers (Python's), so the report names the lower one, and its code
+    is the exit code."""
+    backup = tmp_path / "b.mcm"
+    with serve(macros=dict(OLD), faults=Faults(md_delay=0.2)) as (server, vc):
+        proc = flashing(server.path, str(program_file), "--backup", str(backup))
+        end = time.monotonic() + 20
+        while server.call(lambda _c: vc.md_count) < 1 and time.monotonic() < end:
+            time.sleep(0.005)
+        proc.send_signal(signal.SIGTERM)
+        proc.send_signal(second)
+        out, err = proc.communicate(timeout=20)
+    named = re.search(r"mercmac: flash stopped: interrupted \((Ctrl-C|SIG\w+)\)", err)
+    assert named and str(backup) in err, err
+    signum = signal.SIGINT if named[1] == "Ctrl-C" else signal.Signals[named[1]]
+    assert signum in (signal.SIGTERM, second) and proc.returncode == 128 + signum
+    assert "Traceback" not in err and "Exception ignored" not in err
+
+
 @pytest.fixture
 def rig(tmp_path) -> Path:
     """The raster example where a test may write beside it: two C-663, addresses 0 and 1."""
