@@ -46,13 +46,18 @@ def flashing(*args: str) -> subprocess.Popen:
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
-def signal_once_written(proc: subprocess.Popen, server, vc, signum: int) -> tuple[str, str]:
-    """Send SIGNUM once VC has taken an MD line (the flash is writing it); the output."""
+def once_written(proc: subprocess.Popen, server, vc) -> None:
+    """Return once VC has taken an MD line: the flash is writing it."""
     end = time.monotonic() + 20
     while server.call(lambda _c: vc.md_count) < 1 and proc.poll() is None \
             and time.monotonic() < end:
         time.sleep(0.005)
     assert proc.poll() is None, proc.communicate()
+
+
+def signal_once_written(proc: subprocess.Popen, server, vc, signum: int) -> tuple[str, str]:
+    """Send SIGNUM once VC has taken an MD line; the output."""
+    once_written(proc, server, vc)
     proc.send_signal(signum)
     return proc.communicate(timeout=20)
 
@@ -98,9 +103,7 @@ def test_a_second_signal_at_once_keeps_the_report_of_the_first(second, program_f
     backup = tmp_path / "b.mcm"
     with serve(macros=dict(OLD), faults=Faults(md_delay=0.2)) as (server, vc):
         proc = flashing(server.path, str(program_file), "--backup", str(backup))
-        end = time.monotonic() + 20
-        while server.call(lambda _c: vc.md_count) < 1 and time.monotonic() < end:
-            time.sleep(0.005)
+        once_written(proc, server, vc)
         proc.send_signal(signal.SIGTERM)
         proc.send_signal(second)
         out, err = proc.communicate(timeout=20)
