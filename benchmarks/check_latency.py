@@ -35,7 +35,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=31)
     args = parser.parse_args()
-    check = [sys.executable, "-c", "from mercmac.cli import main; main()", "check", str(EXAMPLE)]
+    # what the console script runs (pyproject.toml [project.scripts]): the entry point first
+    check = [sys.executable, "-c", "from mercmac.__main__ import main; main()", "check",
+             str(EXAMPLE)]
     bare = [sys.executable, "-c", "pass"]
     wall(check), wall(bare)  # warm the file cache
     checks, bares = [], []

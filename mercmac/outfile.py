@@ -3,13 +3,13 @@
 Every file mercmac writes (build output, backups, pulled programs, VCD dumps,
 the emulator's state, `fmt`) goes through here. The text goes to a temporary file in
 the same folder, is flushed to disk, and replaces the old file only when it is
-complete; on any failure, Ctrl-C and SIGTERM included, the temporary file is removed
+complete; on any failure, Ctrl-C, SIGTERM and SIGHUP included, the temporary file is removed
 and the old file is untouched.
 
 A file with more than one name (hard links) is written in place instead, so that every
 name sees the new text (issue 20): the new bytes are complete on disk first, the old
 bytes are copied beside the file, the space is reserved, and only then is the file
-overwritten and cut to length, with Ctrl-C and SIGTERM held off. If that fails (an I/O
+overwritten and cut to length, with Ctrl-C, SIGTERM and SIGHUP held off. If that fails (an I/O
 error) the old bytes are written back; if even that fails, or the machine stops midway,
 the copy beside the file (`.mercmac-*.tmp`) holds the old text, and the error names it.
 
@@ -41,7 +41,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Iterator, NamedTuple
 
-from mercmac.errors import InputError
+from mercmac.errors import STOPPING, InputError
 
 TEMP_PREFIX = ".mercmac-"
 TEMP_SUFFIX = ".tmp"
@@ -372,9 +372,9 @@ def _copy_into(source: str | Path, target: Path) -> None:
 
 @contextlib.contextmanager
 def _held_signals() -> Iterator[None]:
-    """Ctrl-C and SIGTERM wait while a file is overwritten in place (POSIX): the write
-    and, on an I/O error, the restore are never cut in half. They come right after."""
-    held = {signal.SIGINT, signal.SIGTERM}
+    """Ctrl-C, SIGTERM and SIGHUP wait while a file is overwritten in place (POSIX): the
+    write and, on an I/O error, the restore are never cut in half. They come right after."""
+    held = set(STOPPING)
     if not hasattr(signal, "pthread_sigmask"):
         yield
         return
@@ -395,14 +395,16 @@ def _terminated(signum, frame) -> None:
 
 @contextlib.contextmanager
 def _terminable(path) -> Iterator[None]:
-    """While a file is written, SIGTERM raises _Terminated (main thread only, where Python
-    runs signal handlers), so that the cleanup runs; then the signal is delivered again
-    to the handler before (by default the process ends, killed by SIGTERM, as it would have)."""
+    """While a file is written, SIGTERM, if it would end the process on the spot (SIG_DFL),
+    raises _Terminated (main thread only, where Python runs signal handlers), so that the
+    cleanup runs; then the signal is delivered again and the process ends, killed by SIGTERM,
+    as it would have. A command of mercmac's has its own handler (cli.common.run_guarded: the
+    KeyboardInterrupt that Ctrl-C raises too), which the cleanup already answers."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     previous = signal.getsignal(signal.SIGTERM)
-    if previous in (signal.SIG_IGN, None):
+    if previous is not signal.SIG_DFL:
         yield
         return
     signal.signal(signal.SIGTERM, _terminated)

@@ -4,11 +4,15 @@ of its own to leave the block). Real files in a temporary folder."""
 from __future__ import annotations
 
 import os
+import signal
+import subprocess
+import sys
 
 import pytest
 
 from mercmac import outfile
 from helpers.files import leftovers
+from helpers.paths import ROOT
 
 
 @pytest.fixture
@@ -49,3 +53,24 @@ def test_a_new_file_let_go_is_never_created(tmp_path):
         draft.file.write("x")
         draft.keep = False
     assert not path.exists() and leftovers(tmp_path) == []
+
+
+# A program of its own (not mercmac's command line, which answers SIGTERM itself) whose
+# SIGTERM is the default, killing it: the draft it was writing goes before it dies.
+KILLED_WHILE_DRAFTING = """
+import os, signal, sys
+from mercmac import outfile
+with outfile.drafting(sys.argv[1], encoding="ascii") as draft:
+    draft.file.write("half a dump\\n")
+    os.kill(os.getpid(), signal.SIGTERM)
+    draft.file.write("never written\\n")
+"""
+
+
+@pytest.mark.skipif(os.name != "posix", reason="POSIX signals")
+def test_sigterm_by_default_kills_a_program_drafting_but_not_before_the_draft_goes(old):
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    done = subprocess.run([sys.executable, "-c", KILLED_WHILE_DRAFTING, str(old)], timeout=60,
+                          capture_output=True, text=True, env=env)
+    assert done.returncode == -signal.SIGTERM, done.stderr  # it still ends as killed
+    assert old.read_text(encoding="ascii") == "the old dump\n" and leftovers(old.parent) == []

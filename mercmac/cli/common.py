@@ -11,7 +11,8 @@ from typing import Callable
 import click
 
 from mercmac.commands import MODELS
-from mercmac.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_USAGE, InputError, MercmacError
+from mercmac.errors import (EXIT_FAILED, EXIT_USAGE, STOPPING, InputError, MercmacError,
+                            exit_code_for, interrupt, interrupted, signal_of)
 
 MODEL_CHOICE = click.Choice(MODELS, case_sensitive=False)
 
@@ -54,24 +55,24 @@ class FiniteFloat(click.ParamType):
 
 def run_guarded(work: Callable[[], int]) -> None:
     """Run a command body; exit with its code, or with a message and no traceback."""
-    previous = _interrupt_handler()
+    previous = _catch_signals()
     failure: BaseException | None = None
     try:
         try:
             code = work()
         finally:
-            # The outcome is decided: a further Ctrl-C must not cut its report short, nor
+            # The outcome is decided: a further signal must not cut its report short, nor
             # land in the interpreter's shutdown ("Exception ignored in threading._shutdown").
-            _hold_interrupts()
+            _hold_signals(previous)
     except (MercmacError, KeyboardInterrupt, OSError) as e:
-        failure = e  # a Ctrl-C that came while holding still has the report in its context
+        failure = e  # a signal that came while holding still has the report in its context
     try:
-        _hold_interrupts()
+        _hold_signals(previous)
         if failure is not None:
             code = _tell(failure)
     finally:
-        if not _owns_process():  # a test runner or a host program keeps its Ctrl-C
-            _release_interrupts(previous)
+        if not _owns_process():  # a test runner or a host program keeps its handlers
+            _release_signals(previous)
     sys.exit(code)
 
 
@@ -83,8 +84,8 @@ def _tell(e: BaseException) -> int:
         say(e.message, e.hint)
         return e.exit_code
     if isinstance(e, KeyboardInterrupt):
-        say("interrupted")
-        return EXIT_INTERRUPTED
+        say(interrupted(signal_of(e)))
+        return exit_code_for(signal_of(e))
     if isinstance(e, BrokenPipeError):  # `mercmac sim ... | head`: the reader has gone, so stop quietly
         _silence_stdout()
         return EXIT_FAILED
@@ -97,36 +98,60 @@ def _tell(e: BaseException) -> int:
 
 
 def _report_cut_short(interrupt: KeyboardInterrupt) -> MercmacError | None:
-    """The report on its way when this Ctrl-C came (a second one, during the tidy-up)."""
+    """The report on its way when this signal came (a second one, during the tidy-up)."""
     seen = interrupt.__context__
     while seen is not None and not isinstance(seen, MercmacError):
         seen = seen.__context__
     return seen
 
 
-def _interrupt_handler():
-    """What Ctrl-C does now; None off the main thread, where it is not ours to change."""
+def _catch_signals() -> dict | None:
+    """While the work runs, Ctrl-C raises KeyboardInterrupt and SIGTERM or SIGHUP raise
+    Signalled, so that whatever tidies up after Ctrl-C answers all three alike (SPEC §5).
+    A signal the process ignores (started by `nohup`, or with `&`) stays ignored. The handlers
+    before, by signal number, to put back; None off the main thread, where they are not
+    ours to change."""
     if threading.current_thread() is not threading.main_thread():
         return None
-    return signal.getsignal(signal.SIGINT)
+    previous = {}
+    for signum in STOPPING:
+        handler = signal.getsignal(signum)
+        if handler not in (signal.SIG_IGN, None):  # None: set outside Python, not ours
+            previous[signum] = handler
+            signal.signal(signum, _raise_interrupt)
+    return previous
 
 
-def _hold_interrupts() -> None:
-    """Ignore Ctrl-C from now on (main thread only)."""
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
+def _raise_interrupt(signum: int, frame) -> None:
+    raise interrupt(signum)
 
 
-def _release_interrupts(previous) -> None:
-    if previous is not None:
-        signal.signal(signal.SIGINT, previous)
+def _hold_signals(previous: dict | None) -> None:
+    """Ignore the signals the command caught, from now on."""
+    for signum in previous or ():
+        signal.signal(signum, signal.SIG_IGN)
+
+
+def _release_signals(previous: dict | None) -> None:
+    for signum, handler in (previous or {}).items():
+        signal.signal(signum, handler)
+
+
+_program = False  # True once the entry point (mercmac.__main__) runs: the process is ours
+
+
+def run_as_program() -> None:
+    """The command line is the program running (mercmac.__main__): its signal handlers stay
+    held after a command, until the process ends."""
+    global _program
+    _program = True
 
 
 def _owns_process() -> bool:
     """Whether mercmac's command line is the program running, not a test calling it."""
     ctx = click.get_current_context(silent=True)
     program = getattr(sys.modules.get("__main__"), "main", None)
-    return ctx is not None and program is ctx.find_root().command
+    return _program or (ctx is not None and program is ctx.find_root().command)
 
 
 def _silence_stdout() -> None:
@@ -141,10 +166,14 @@ def _silence_stdout() -> None:
 
 def say(message: str, hint: str | None = None) -> None:
     """The message on standard error, each of its lines escaped: a message quotes file
-    names, ports and option values, which may hold any character (mercmac/names.py)."""
-    click.echo(f"mercmac: {_escaped(message)}", err=True)
-    if hint:
-        click.echo(f"  hint: {_escaped(hint)}", err=True)
+    names, ports and option values, which may hold any character (mercmac/names.py);
+    nothing if standard error is gone (a hung-up terminal)."""
+    try:
+        click.echo(f"mercmac: {_escaped(message)}", err=True)
+        if hint:
+            click.echo(f"  hint: {_escaped(hint)}", err=True)
+    except OSError:
+        pass
 
 
 def _escaped(text: str) -> str:

@@ -57,11 +57,22 @@ def run(machine: Machine, *, speed: float = 1.0, hold: tuple[int, ...] = (),
     try:
         _loop(machine, record, speed, hold, fd, stdout)
     finally:
+        _restore(fd, saved, stdout)
+    write_lines(render.summary(Run(machine, record, round(machine.now_ms))), stdout)
+    return len(record.hazards)
+
+
+def _restore(fd: int, saved: list, stdout: IO[str]) -> None:
+    """The terminal's settings as they were, the cursor on a new line; nothing if the terminal
+    has hung up (SIGHUP is on its way: that, not this failure, ends the run, exit 129)."""
+    import termios
+
+    try:
         termios.tcsetattr(fd, termios.TCSADRAIN, saved)
         stdout.write("\n")
         stdout.flush()
-    write_lines(render.summary(Run(machine, record, round(machine.now_ms))), stdout)
-    return len(record.hazards)
+    except (termios.error, OSError):
+        pass
 
 
 def _loop(machine: Machine, record: Recorder, speed: float, hold: tuple[int, ...], fd: int,

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 from mercmac.commands import MAX_INT32
 from mercmac.cli.common import UsageError, say
+from mercmac.errors import interrupt
 from mercmac.outfile import drafting, writable_target
 from mercmac.timespec import TimeSpecError, parse_buttons, parse_duration
 from mercmac.vm.models import Options
@@ -96,8 +97,8 @@ def _run(req: Request) -> bool:
     until = _until(req.until, None)
     result = _simulate(req, program, presses, until, common)
     _render(req, result)
-    if result.interrupted:  # Ctrl-C: the timeline so far and the summary, then exit 130
-        raise KeyboardInterrupt
+    if result.interrupted:  # Ctrl-C: the timeline so far and the summary, then exit 128+N
+        raise interrupt(result.interrupted)
     return _hazards_ok(req, len(result.record.hazards))
 
 

@@ -16,6 +16,7 @@ import sys
 from mercmac.cli.common import UsageError
 from mercmac.cli.run import _hazards_ok, _until  # the single controller's, alike
 from mercmac.cli.run import _hold as _held_at_power_on
+from mercmac.errors import interrupt
 from mercmac.outfile import drafting, writable_target
 from mercmac.rig.model import Rig
 from mercmac.sim.rig import Hold, RigRun, RigSim
@@ -48,7 +49,7 @@ def run(req) -> bool:
     if not req.scenario:  # a scenario's run showed itself, passed or failed
         _render(req, result)
     if result.interrupted:
-        raise KeyboardInterrupt
+        raise interrupt(result.interrupted)
     return _hazards_ok(req, result.hazards)
 
 

@@ -12,7 +12,8 @@ import click
 
 from mercmac.cli.common import MODEL_CHOICE, FiniteFloat, UsageError, run_guarded
 from mercmac.emulator.faults import EmptySlot, Framing  # two enums: light to import
-from mercmac.errors import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, InputError, MercmacError
+from mercmac.errors import (EXIT_FAILED, EXIT_OK, InputError, MercmacError, exit_code_for,
+                            signal_of)
 
 _ADDRESS = click.option("--address", type=click.IntRange(0, 15), default=0, show_default=True,
                         help="Controller address, DIP switches 1-4 (MS176E §3.1.3).")
@@ -252,14 +253,14 @@ def _reporting_completion(work, finished) -> int:
     """Run `work`; a Ctrl-C once the flash is complete (closing, printing) says what was done."""
     try:
         return work()
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as e:
         if finished[0] is None:
             raise
         from mercmac.render.upload import completed_text
         from mercmac.upload.errors import FlashInterrupted
 
-        raise FlashInterrupted(f"interrupted while showing the result; {completed_text(finished[0])}") \
-            from None
+        raise FlashInterrupted("interrupted while showing the result; "
+                               f"{completed_text(finished[0])}", by=e) from None
 
 
 def _watch(port: str, address: int | None, finished: list):
@@ -596,8 +597,8 @@ def emulate(target, address, addresses, rig_path, state, firmware, tm_framing, e
             click.echo(server.path)
             try:
                 server.serve_forever()
-            except KeyboardInterrupt:  # the only way it ends: 130, as `scan` and `sim -i` exit
-                return EXIT_INTERRUPTED
+            except KeyboardInterrupt as e:  # the only way it ends (128+N), as `scan` and `sim -i`
+                return exit_code_for(signal_of(e))
             finally:
                 server.close()
         return EXIT_OK

@@ -52,6 +52,7 @@ class FlashProgress:
         self.stream = stream or sys.stdout
         self._progress = self._task = None
         self._started: tuple[float, int] | None = None  # (time, bytes sent) at the first step
+        self._gone = False  # the stream cannot be written any more
 
     def __enter__(self) -> "FlashProgress":
         if use_colour(self.stream):
@@ -69,8 +70,17 @@ class FlashProgress:
         return self
 
     def __exit__(self, *exc) -> None:
-        if self._progress:
-            self._progress.stop()
+        if self._progress and not self._gone:
+            self._drawing(self._progress.stop)
+
+    def _drawing(self, draw, *args) -> None:
+        """Draw, unless the stream is gone: a hung-up terminal (SIGHUP follows) or a pipe
+        whose reader left. The flash goes on undrawn, and its report (on standard error,
+        perhaps a file) is not replaced by this error."""
+        try:
+            draw(*args)
+        except OSError:
+            self._gone = True
 
     def _rate(self, event) -> str:
         """Bytes per second since the first step, and the time left at that rate."""
@@ -83,6 +93,10 @@ class FlashProgress:
         return _rate_text(event.sent - sent0, event.size - sent0, now - start)
 
     def __call__(self, event: Event) -> None:
+        if not self._gone:
+            self._drawing(self._show, event)
+
+    def _show(self, event: Event) -> None:
         if self._progress is None:
             if event.kind != EventKind.STEP:  # a log line says what was done, not what begins
                 write_lines([_event_line(event)], self.stream)

@@ -25,6 +25,7 @@ from dataclasses import dataclass, replace
 from typing import Iterable, Mapping, Sequence
 
 from mercmac.compiler.program import Program
+from mercmac.errors import signal_of
 from mercmac.rig.model import Rig, Wire
 from mercmac.sim.record import CAP
 from mercmac.sim.rig_ff import JointForward, tell, where
@@ -67,7 +68,7 @@ class RigRun:
     edges: list[Edge]
     until_ms: int
     edges_dropped: int = 0  # past CAP edges are counted, not listed (as SPEC §5 lists)
-    interrupted: bool = False
+    interrupted: int = 0  # the signal that stopped the run (SIGINT: Ctrl-C), 0: none
 
     @property
     def hazards(self) -> int:
@@ -229,12 +230,13 @@ class RigSim:
         return f"from {wires[0].source}, which stays {_word(level)}: {source} {state}"
 
     def run(self, until_ms: int) -> RigRun:
-        """Power on and run to until_ms; Ctrl-C ends the run where it is (`interrupted`)."""
+        """Power on and run to until_ms; Ctrl-C, SIGTERM or SIGHUP ends the run where it is
+        (`interrupted`: the signal)."""
         self.power_on()
         try:
             self.run_until(until_ms)
-        except KeyboardInterrupt:
-            return self.result(round(self.now_ms()), interrupted=True)
+        except KeyboardInterrupt as e:
+            return self.result(round(self.now_ms()), interrupted=signal_of(e))
         return self.result(until_ms)
 
     def now_ms(self) -> float:
@@ -242,7 +244,7 @@ class RigSim:
         return min(m.now_ms for m in self.machines.values())
 
     # ------------------------------------------------------------ the result
-    def result(self, until_ms: int, interrupted: bool = False) -> RigRun:
+    def result(self, until_ms: int, interrupted: int = 0) -> RigRun:
         runs = {name: Run(m, self.records[name], until_ms, interrupted=interrupted)
                 for name, m in self.machines.items()}
         return RigRun(self.rig, runs, self.edges, until_ms, self.edges_dropped, interrupted)

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 from typing import IO, Iterable, Sequence
 
 from mercmac.compiler.program import Program
+from mercmac.errors import signal_of
 from mercmac.timespec import Press
 from mercmac.vm.machine import Listener, Machine
 from mercmac.vm.models import Options
@@ -22,7 +23,8 @@ class Run:
     record: Recorder
     until_ms: int
     vcd_cut_at: int | None = None  # us: where the VCD stopped at its size limit
-    interrupted: bool = False  # Ctrl-C stopped it at until_ms: the record is what came so far
+    interrupted: int = 0  # the signal that stopped it at until_ms (SIGINT: Ctrl-C), 0: none;
+    # the record is what came so far
 
     @property
     def halted(self) -> bool:
@@ -70,7 +72,8 @@ def simulate(program: Program, *, presses: Iterable[Press] = (), until_ms: int =
     A VCD stops (a valid file) before it would pass `vcd_limit` bytes; the run goes on.
     `watch` is one more listener (a plot) with `on_event`; it hears every event first.
     `progress` (`update(now_ms)`, `close()`) hears the simulated time reached as the run goes.
-    Ctrl-C (KeyboardInterrupt) ends the run where it is: the Run is marked `interrupted`.
+    Ctrl-C (KeyboardInterrupt, or Signalled: SIGTERM, SIGHUP) ends the run where it is: the
+    Run's `interrupted` is the signal.
     """
     dump = None
     if vcd is not None:
@@ -82,14 +85,14 @@ def simulate(program: Program, *, presses: Iterable[Press] = (), until_ms: int =
                                   trace=trace, listeners=listeners)
     schedule(machine, presses)
     machine.power_on()
-    interrupted = False
+    interrupted = 0
     try:
         if progress is None:
             machine.run_until(until_ms)
         else:
             run_reporting(machine, until_ms, progress.update)
-    except KeyboardInterrupt:
-        interrupted, until_ms = True, machine.now_ms
+    except KeyboardInterrupt as e:
+        interrupted, until_ms = signal_of(e), machine.now_ms
     finally:
         if progress is not None:
             progress.close()

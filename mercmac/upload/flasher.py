@@ -16,6 +16,7 @@ from typing import Callable, Iterator
 from mercmac.compiler import Compilation, compile_file
 from mercmac.compiler.program import Program
 from mercmac import mdtext
+from mercmac.errors import how, signal_of
 from mercmac.upload import backup, protocol, survey
 from mercmac.upload.controller import Controller, ControllerError, LinkLost
 from mercmac.upload.errors import FlashFailed, FlashInterrupted, Refused
@@ -156,8 +157,9 @@ def flash_file(port: str, path: str, *, address: int | None = 0, baud: int = DEF
                 program = compiled.program
                 watch.compiled(compiled)
             watch.identified(who, check_model(who, program.target, path, force=force))
-        except KeyboardInterrupt:
-            raise FlashInterrupted("interrupted before the first write; nothing was written") from None
+        except KeyboardInterrupt as e:
+            raise FlashInterrupted("interrupted before the first write; nothing was written",
+                                   by=e) from None
         with watch.writing() as notify:
             result = flash(c, who, program, options, notify)
             result.restoring = _is_backup(path)
@@ -233,10 +235,10 @@ def prepare(controller: Controller, identity: Identity, program: Program,
         notify(Event(EventKind.BACKUP, str(result.backup), len(stored)))
     except ControllerError as e:
         raise refusal(controller, e) from None
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as e:
         saved = f"; backup: {result.backup}" if result and result.backup else ""
-        raise FlashInterrupted(f"interrupted before the first write; nothing was written{saved}") \
-            from None
+        raise FlashInterrupted(f"interrupted before the first write; nothing was written{saved}",
+                               by=e) from None
     return result
 
 
@@ -284,24 +286,32 @@ class _Run:
                 sent += sizes[i]
                 self.notify(Event(EventKind.VERIFIED, f"{step.describe}: verified", i + 1, total,
                                   sent, size))
-        except KeyboardInterrupt:
-            kind, cause, alive = FlashInterrupted, "interrupted (Ctrl-C)", True
+        except KeyboardInterrupt as e:  # Ctrl-C, SIGTERM or SIGHUP (mercmac.errors.Signalled)
+            cause, alive, by = None, True, e
         except _Mismatch as e:
             self.verify_failed = True
-            kind, cause, alive = FlashFailed, e.args[0], True
+            cause, alive, by = e.args[0], True, None
         except ControllerError as e:
-            kind, cause, alive = FlashFailed, _cause(e), not isinstance(e, LinkLost)
+            cause, alive, by = _cause(e), not isinstance(e, LinkLost), None
         else:
             return
-        # Inline, with no call before the `try`: a second Ctrl-C, pending since the first,
+        # Inline, with no call before the `try`: a second signal, pending since the first,
         # fires at the first call and must land inside it. It skips the tidy-up, never the report.
         while True:
             try:
-                stopped = kind(self._report(cause, alive=alive), hint=self._hint())
+                stopped = self._stopped(cause, alive, by)
                 break
             except KeyboardInterrupt:
                 alive = False  # no more talking to the controller: just say where things stand
         raise stopped from None
+
+    def _stopped(self, cause: str | None, alive: bool, by: KeyboardInterrupt | None) -> FlashFailed:
+        """The error that ends the flash, with the report; FlashInterrupted when a signal BY
+        stopped it (its words, and its exit code 128+N)."""
+        if by is None:
+            return FlashFailed(self._report(cause, alive=alive), hint=self._hint())
+        cause = f"interrupted ({how(signal_of(by))})"
+        return FlashInterrupted(self._report(cause, alive=alive), hint=self._hint(), by=by)
 
     def reset(self) -> None:
         try:
@@ -309,11 +319,12 @@ class _Run:
         except ControllerError as e:
             raise FlashFailed(f"all macros are written and verified, but RT failed: {_cause(e)}",
                               hint="power-cycle the controller to start macro 0") from None
-        except KeyboardInterrupt:
+        except KeyboardInterrupt as e:
             raise FlashInterrupted(f"all macros are written and verified (backup: "
                                    f"{self.result.backup}); interrupted while sending RT, so "
                                    f"macro 0 may not have started",
-                                   hint="power-cycle the controller to start macro 0") from None
+                                   hint="power-cycle the controller to start macro 0",
+                                   by=e) from None
         self.notify(Event(EventKind.RESET, "RT sent: the controller restarts and runs macro 0"))
 
     def _apply(self, step: Step) -> None:
@@ -413,8 +424,9 @@ class _Run:
 
     def _hint(self) -> str:
         t = self.c.transport
+        at = f" --address {self.c.address}" if self.c.address else ""  # a chain's other controller
         return (f"run the same `mercmac flash` again to finish (it writes only what differs); "
-                f"`mercmac flash {t.port} {self.result.backup} --erase-unused` puts the old "
+                f"`mercmac flash {t.port} {self.result.backup}{at} --erase-unused` puts the old "
                 f"program back")
 
 

@@ -14,6 +14,7 @@ import re
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from enum import Enum
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Iterator
 
@@ -252,10 +253,10 @@ def _meet(link: Link, chosen: list[Part], result: RigResult, options: FlashOptio
             raise Refused(f"{part.name} (address {part.member.address}): {e.message}\n"
                           f"{_states(result)}", hint=e.hint) from None
         except FlashInterrupted as e:
-            raise FlashInterrupted(f"{part.name}: {e.message}\n{_states(result)}") from None
-        except KeyboardInterrupt:
+            raise FlashInterrupted(f"{part.name}: {e.message}\n{_states(result)}", by=e) from None
+        except KeyboardInterrupt as e:
             raise FlashInterrupted(f"interrupted at {part.name}, before the first write; "
-                                   f"nothing was written\n{_states(result)}") from None
+                                   f"nothing was written\n{_states(result)}", by=e) from None
         part.state = State.PLANNED if options.dry_run else State.UNTOUCHED
 
 
@@ -287,7 +288,8 @@ def _write_all(link: Link, chosen: list[Part], result: RigResult, path: str,
             with watch.writing(part) as notify:
                 flasher.write(c, part.result, notify)
         except FlashFailed as e:
-            kind = FlashInterrupted if isinstance(e, FlashInterrupted) else FlashFailed
+            kind = partial(FlashInterrupted, by=e) if isinstance(e, FlashInterrupted) \
+                else FlashFailed
             raise kind(f"rig flash stopped at {part.name} (address {part.member.address}): "
                        f"{e.message}\n{_states(result)}", hint=e.hint) from None
         part.state = State.UNCHANGED if part.result.plan.changes_nothing else State.FLASHED

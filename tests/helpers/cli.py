@@ -49,3 +49,16 @@ def hang_guard(seconds: int = HANG_S):
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, old)
+
+
+def on_a_terminal(slave: int):
+    """Popen's preexec_fn: the child leads a session whose controlling terminal is the pty
+    SLAVE, so that closing the master hangs it up and the kernel sends the child SIGHUP, as
+    when an ssh connection drops (POSIX)."""
+    def become() -> None:
+        import fcntl
+        import termios
+
+        os.setsid()
+        fcntl.ioctl(slave, termios.TIOCSCTTY, 0)
+    return become

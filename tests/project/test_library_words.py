@@ -16,7 +16,9 @@ from helpers.paths import PACKAGE, ROOT
 # The language server's standard output is its wire to the editor (LSP base protocol).
 WIRES = {"mercmac/lsp/server.py": {"stdout"}}
 MODULES = sorted(p for p in PACKAGE.rglob("*.py") if p.name != "parser_tables.py")  # lark's
-LIBRARY = [p for p in MODULES if p.relative_to(PACKAGE).parts[0] != "cli"]
+# The application: mercmac/cli/, and the program's entry point before it (it says which signal
+# stopped the program when the command line could not be imported yet: mercmac/__main__.py).
+LIBRARY = [p for p in MODULES if p.relative_to(PACKAGE).parts[0] not in ("cli", "__main__.py")]
 # The library less render/, which draws text onto the streams it is handed.
 QUIET = [p for p in LIBRARY if p.relative_to(PACKAGE).parts[0] != "render"]
 
