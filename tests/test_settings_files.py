@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers.cli import cli
+from helpers.cli import as_nobody, cli
 from mercmac import config
 
 WARNS = "[MC00] EM5,WS\n"  # undefined-macro (MM012, warning) and default-argument (info)
@@ -205,12 +205,7 @@ def test_an_unreadable_settings_file_is_worded():
 
 def _as_user(args: list[str]) -> subprocess.CompletedProcess:
     """`mercmac ARGS` in a process of its own, as `nobody` (uid 65534) when we are root."""
-    prefix = []
-    if ROOT:
-        setpriv = "/usr/bin/setpriv"
-        if not os.path.exists(setpriv):
-            pytest.skip("root, and no setpriv to drop privileges")
-        prefix = [setpriv, "--reuid=65534", "--regid=65534", "--clear-groups"]
+    prefix = as_nobody()
     env = dict(os.environ, NO_COLOR="1")
     return subprocess.run([*prefix, sys.executable, "-m", "mercmac", *args], capture_output=True,
                           text=True, timeout=120, env=env, cwd="/")

@@ -68,7 +68,10 @@ class Record:
 
     @property
     def when(self) -> _dt.datetime:
-        return _dt.datetime.fromisoformat(self.time)
+        """The record's time; ValueError when it is no ISO 8601 time. A `Z` for UTC is read
+        on every Python (fromisoformat takes it from 3.11 on; on 3.10 it is written +00:00)."""
+        time = self.time[:-1] + "+00:00" if self.time[-1:] in ("Z", "z") else self.time
+        return _dt.datetime.fromisoformat(time)
 
 
 class Skipped(NamedTuple):

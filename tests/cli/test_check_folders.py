@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers.cli import cli
+from helpers.cli import as_nobody, cli
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="FIFOs, file modes and links")
 CLEAN = "[MC00] TP\n"
@@ -22,11 +22,7 @@ ROOT = os.geteuid() == 0
 def _run(*args, cwd, user: bool = False) -> subprocess.CompletedProcess:
     """`mercmac ARGS` as a real process, so that a hang is a timeout and not a stuck test;
     with USER, as `nobody` when the tests run as root (root reads any folder)."""
-    prefix = []
-    if user and ROOT:
-        if not os.path.exists("/usr/bin/setpriv"):
-            pytest.skip("root, and no setpriv to drop privileges")
-        prefix = ["/usr/bin/setpriv", "--reuid=65534", "--regid=65534", "--clear-groups"]
+    prefix = as_nobody() if user else []
     env = dict(os.environ, NO_COLOR="1")
     return subprocess.run([*prefix, sys.executable, "-m", "mercmac", *args], cwd=cwd, env=env,
                           capture_output=True, text=True, timeout=60, preexec_fn=_memory_cap)

@@ -62,3 +62,24 @@ def on_a_terminal(slave: int):
         os.setsid()
         fcntl.ioctl(slave, termios.TIOCSCTTY, 0)
     return become
+
+
+def as_nobody() -> list[str]:
+    """The words that run a command as `nobody` (uid 65534) when the tests run as root (root
+    reads any file, so an unreadable one needs another user); skips the test, saying why,
+    where no user can be dropped to or this interpreter cannot start as that user (a Python
+    whose shared library lies in root's home, as pyenv's 3.10 does)."""
+    import pytest
+
+    if os.geteuid() != 0:
+        return []
+    setpriv = "/usr/bin/setpriv"
+    if not os.path.exists(setpriv):
+        pytest.skip("root, and no setpriv to drop privileges")
+    prefix = [setpriv, "--reuid=65534", "--regid=65534", "--clear-groups"]
+    probe = subprocess.run([*prefix, sys.executable, "-c", "pass"], capture_output=True,
+                           text=True, timeout=60, cwd="/")
+    if probe.returncode != 0:
+        pytest.skip(f"{sys.executable} does not start as nobody: "
+                    f"{probe.stderr.strip()[:200]}")
+    return prefix
