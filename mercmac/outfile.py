@@ -172,7 +172,17 @@ def fill(folder: str | os.PathLike, texts: dict[str, str], *, replace: bool = Fa
     plain file name, anything writable_target refuses, a symlink (never followed in a folder
     mercmac fills, even with REPLACE: it could point anywhere), and unless REPLACE, a file
     that is there already (Occupied, naming them all). Returns the files written."""
-    paths = [in_folder(folder, name) for name in texts]
+    paths = _fillable(folder, list(texts), replace)
+    writable_folder(folder, make=True)
+    for path, text in zip(paths, texts.values()):
+        write_text(path, text, follow=False)
+    return paths
+
+
+def _fillable(folder: str | os.PathLike, names: list[str], replace: bool) -> list[Path]:
+    """FOLDER/NAME for each of NAMES, or the refusal `fill` would make, before anything is
+    written."""
+    paths = [in_folder(folder, name) for name in names]
     writable_folder(folder, doing=f"cannot write in {folder}")
     there = []
     for path in paths:
@@ -186,10 +196,45 @@ def fill(folder: str | os.PathLike, texts: dict[str, str], *, replace: bool = Fa
             there.append(path)
     if there and not replace:
         raise Occupied(there)
-    writable_folder(folder, make=True)
-    for path, text in zip(paths, texts.values()):
-        write_text(path, text, follow=False)
     return paths
+
+
+def fill_tree(root: str | os.PathLike, texts: dict[str, str], *,
+              replace: bool = False) -> list[Path]:
+    """`fill` for a tree: TEXTS maps a path below ROOT ('rigs/raster/x.mcm', parts joined
+    by '/') to its text. Every folder on the way is made if missing and none may be a
+    symlink (never followed in a tree mercmac fills); every target of every folder is
+    checked before the first is written (Occupied names all the files there already)."""
+    groups: dict[tuple[str, ...], dict[str, str]] = {}
+    for path, text in texts.items():
+        *folders, name = path.split("/")
+        groups.setdefault(tuple(folders), {})[name] = text
+    there = []
+    for folders, group in groups.items():
+        try:
+            _fillable(_subfolder(root, folders), list(group), replace)
+        except Occupied as e:
+            there += e.paths
+    if there:
+        raise Occupied(there)
+    return [path for folders, group in groups.items()
+            for path in fill(_subfolder(root, folders), group, replace=replace)]
+
+
+def _subfolder(root: str | os.PathLike, parts: tuple[str, ...]) -> Path:
+    """ROOT/PART/..., each part a plain name and, where it exists, a folder and no link."""
+    folder = Path(root)
+    for part in parts:
+        folder = in_folder(folder, part)
+        if folder.is_symlink():
+            raise OutputError(f"cannot write in {folder}: it is a symbolic link (to "
+                              f"{os.readlink(folder)}); mercmac does not write through a link "
+                              f"in a folder it fills", hint="remove the link, or choose "
+                              "another folder")
+        if os.path.lexists(folder) and not folder.is_dir():
+            raise OutputError(f"cannot write in {folder}: it is no folder",
+                              hint="move it away, or choose another folder")
+    return folder
 
 
 @contextlib.contextmanager

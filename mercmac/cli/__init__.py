@@ -27,6 +27,8 @@ class _Commands(click.Group):
         "decompile": ("mercmac.cli.inspect", "decompile"),
         "describe": ("mercmac.cli.inspect", "describe"),
         "history": ("mercmac.cli.inspect", "history"),
+        "examples": ("mercmac.cli.scaffold", "examples"),
+        "new": ("mercmac.cli.scaffold", "new"),
     }
 
     # Words people try for a command, and the command they mean (`mercmac simulate`).
