@@ -12,55 +12,13 @@ from __future__ import annotations
 import json
 import re
 import shlex
-import shutil
 from pathlib import Path
 
 import pytest
 
 from helpers.cli import cli
 from helpers.paths import EXAMPLE4
-from helpers.readme import README, commands, tour_program
-
-HARDWARE_PORTS = ("/dev/ttyUSB0", "COM3")
-
-
-# What the text around each command promises: (pattern of the command, exit code, phrases in
-# its output). A command the table does not know must still run and exit 0.
-PROMISES = [
-    (r"check prog\.mcm$", 0, ["No problems found"]),
-    (r"check --format json prog\.mcm$", 0, ['"diagnostics": []']),
-    (r"check --target C-663 prog\.mcm$", 0, ["No problems found"]),
-    (r"check --max-diagnostics 0 big\.mcm$", 1, ["250 errors"]),
-    (r"explain nested-call$", 0, ["nested-call", "§3.8.4"]),
-    (r"explain$", 0, ["nested-call", "too-many-commands", "every-zero"]),
-    (r"fmt prog\.mcm$", 0, []),
-    (r"fmt --check --diff src/$", 1, ["--- ", "+++ ", "+    CN 1"]),
-    (r"check src/macros$", 0, ["No problems found in 1 file"]),
-    (r"check --output-format concise \.$", 0,
-     ["manual-example4-four-modes.mcm:9:8: MM011 [nested-call]"]),
-    (r"check --output-format github \.$", 0,
-     ["::warning file=", "manual-example4-four-modes.mcm,line=9,col=8"]),
-    (r"check --output-format sarif \. > mercmac\.sarif$", 0, []),
-    (r"check --select nested-call,MM012 --ignore unreachable-macro \.$", 0, ["nested-call"]),
-    (r"check --statistics \.$", 0, ["nested-call"]),
-    (r"check --warnings-as-errors \.$", 1, ["3 warnings"]),
-    (r"build prog\.mcm$", 0, ["MD0,XN1,SV70000,EM1"]),
-    (r"build prog\.mcm -o prog\.md$", 0, []),
-    (r"sim prog\.mcm ", 0, ["until 10 s", "button 1 pressed", "goto jog", "button 1 released",
-                           "button 2 pressed", "move to", "still running jog"]),
-    (r"ports$", 0, []),
-    (r"scan PORT$", 0, ["C-863"]),
-    (r"flash PORT prog\.mcm$", 0, ["verified"]),
-    (r"pull PORT -o saved\.mcm$", 0, []),
-]
-
-
-def promise(command: str):
-    rest = command.removeprefix("mercmac ")
-    for pattern, code, phrases in PROMISES:
-        if re.match(pattern, rest):
-            return code, phrases
-    return 0, []
+from helpers.readme import HARDWARE_PORTS, README, commands, prepare, promise, tour_program
 
 
 @pytest.fixture(scope="module")
@@ -71,20 +29,6 @@ def port():
 
     with PtyServer(VirtualController("C-863", 0)) as server:
         yield server.path
-
-
-def prepare(folder: Path, command: str) -> None:
-    """The files the command names, as the README's text describes them."""
-    (folder / "prog.mcm").write_text(tour_program(), encoding="utf-8")
-    shutil.copy(EXAMPLE4, folder)
-    if "big.mcm" in command:  # more than the 200 diagnostics shown by default
-        body = "".join("    XY 1\n" for _ in range(250))
-        (folder / "big.mcm").write_text(f"autostart {{\n{body}}}\n", encoding="utf-8")
-    if "src/" in command:
-        (folder / "src" / "macros").mkdir(parents=True)
-        (folder / "src" / "macros" / "prog.mcm").write_text(tour_program(), encoding="utf-8")
-        # a file written by hand, not in the one layout: fmt --check must see it
-        (folder / "src" / "hand.mcm").write_text("autostart {\nCN 1\n}\n", encoding="utf-8")
 
 
 def run(command: str, port: str, folder: Path, monkeypatch):
