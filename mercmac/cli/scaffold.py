@@ -89,10 +89,10 @@ def _suits(file: str, template: str) -> None:
     from mercmac.rig import is_rig_path
 
     if template in RIG_TEMPLATES and not is_rig_path(file):
-        raise UsageError(f"--template {template} writes a rig, and {printable(file)} is no "
+        raise UsageError(f"--template {template} writes a rig, and '{printable(file)}' is no "
                          f"rig file's name", hint="name it NAME.rig.toml")
     if template not in RIG_TEMPLATES and not file.lower().endswith(".mcm"):
-        raise UsageError(f"--template {template} writes a program, and {printable(file)} "
+        raise UsageError(f"--template {template} writes a program, and '{printable(file)}' "
                          f"does not end in .mcm", hint="name it NAME.mcm (a rig: NAME.rig.toml "
                                                        "with --template raster-rig)")
 

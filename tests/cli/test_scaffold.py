@@ -85,12 +85,12 @@ def test_examples_never_write_through_a_link(tmp_path):
     assert not (target / "scenarios").exists()
 
 
-def test_examples_into_a_file_is_refused(tmp_path):
+@pytest.mark.parametrize("command", ["examples", "new"])
+def test_a_file_where_the_folder_goes_is_refused(command, tmp_path):
     (tmp_path / "f").write_text("", encoding="utf-8")
-    result = cli("examples", tmp_path / "f", catch=True)
-    assert result.exit_code == 2 and result.exception is None or \
-        isinstance(result.exception, SystemExit)
-    assert result.exit_code == 2 and "Traceback" not in result.output
+    result = cli(command, tmp_path / "f" / "prog.mcm", catch=True)
+    assert isinstance(result.exception, SystemExit), result.exception
+    assert result.exit_code == 2 and "is not a folder" in result.stderr
 
 
 # -- mercmac new -------------------------------------------------------------------------------
@@ -171,7 +171,7 @@ def test_new_does_not_write_through_a_link(tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("args,says", [
-    (["prog.txt"], "does not end in .mcm"),
+    (["prog.txt"], "'prog.txt' does not end in .mcm"),
     (["prog.mcm", "--template", "raster-rig"], "NAME.rig.toml"),
     (["xy.rig.toml", "--template", "scan"], "does not end in .mcm"),
     (["prog.mcm", "--template", "nope"], "Invalid value for '--template'"),

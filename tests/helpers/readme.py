@@ -79,6 +79,10 @@ PROMISES = [
     (r"scan PORT$", 0, ["C-863"]),
     (r"flash PORT prog\.mcm$", 0, ["verified"]),
     (r"pull PORT -o saved\.mcm$", 0, []),
+    (r"new stage\.mcm$", 0, ["wrote the jog template for the C-863", "stage.mcm"]),
+    (r"new scan\.mcm --template scan --target C-663$", 0, ["the scan template for the C-663"]),
+    (r"new bench/xy\.rig\.toml$", 0, ["bench/xy.rig.toml", "bench/x.mcm", "bench/y.mcm"]),
+    (r"examples$", 0, ["13 example files in examples:", "examples/rigs/raster/x.mcm"]),
 ]
 
 

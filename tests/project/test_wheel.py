@@ -112,11 +112,21 @@ def run(words: list[str], **kw) -> subprocess.CompletedProcess:
     return subprocess.run(words, capture_output=True, text=True, timeout=TIMEOUT_S, **kw)
 
 
+def outside_env() -> dict:
+    """This environment without PYTHONPATH: nothing of the source tree (a mercmac there, or
+    its .egg-info, which pip would take for an installed mercmac)."""
+    return {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+
+
 def online_or_skip(done: subprocess.CompletedProcess, doing: str) -> None:
     """Skip, saying why, when DONE failed because PyPI could not be reached; fail otherwise."""
     if done.returncode != 0 and OFFLINE.search(done.stdout + done.stderr):
         pytest.skip(f"{doing} needs PyPI, which cannot be reached here")
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+
+
+# The tests of the released package share one build: on one worker (pytest-xdist loadgroup).
+RELEASE = pytest.mark.xdist_group("release")
 
 
 @pytest.fixture(scope="module")
@@ -129,12 +139,14 @@ def released(tmp_path_factory) -> Path:
     shutil.copytree(ROOT, tree, ignore=shutil.ignore_patterns(
         ".git", ".venv", "node_modules", "__pycache__", "build", "dist", "*.egg-info",
         ".hypothesis", ".pytest_cache", "*.vcd", "*.vsix"))
-    done = run([sys.executable, "-m", "build", "--outdir", str(work / "dist"), str(tree)])
+    done = run([sys.executable, "-m", "build", "--outdir", str(work / "dist"), str(tree)],
+               env=outside_env(), cwd=work)
     online_or_skip(done, "`python -m build` (setuptools in an isolated environment)")
     return work / "dist"
 
 
 @pytest.mark.slow
+@RELEASE
 def test_twine_checks_the_sdist_and_the_wheel(released):
     pytest.importorskip("twine", reason="the extra `test` brings `twine`")
     files = sorted(map(str, released.iterdir()))
@@ -144,6 +156,7 @@ def test_twine_checks_the_sdist_and_the_wheel(released):
 
 
 @pytest.mark.slow
+@RELEASE
 def test_the_wheel_holds_the_examples_and_the_sdist_the_tests(released):
     import tarfile
 
@@ -163,9 +176,10 @@ def test_the_wheel_holds_the_examples_and_the_sdist_the_tests(released):
 def installed(released, tmp_path_factory) -> Path:
     """A fresh venv with the wheel (and the extra `lsp`) installed from it: its bin/."""
     venv = tmp_path_factory.mktemp("venv")
-    assert run([sys.executable, "-m", "venv", str(venv)]).returncode == 0
+    assert run([sys.executable, "-m", "venv", str(venv)], env=outside_env()).returncode == 0
     (wheel,) = released.glob("*.whl")
-    done = run([str(venv / "bin" / "python"), "-m", "pip", "install", "-q", f"{wheel}[lsp]"])
+    done = run([str(venv / "bin" / "python"), "-m", "pip", "install", "-q", f"{wheel}[lsp]"],
+               env=outside_env(), cwd=venv)
     online_or_skip(done, "installing the wheel's dependencies")
     return venv / "bin"
 
@@ -175,7 +189,7 @@ class Installed:
     source tree on the path."""
 
     def __init__(self, bin: Path, data: Path):
-        self.env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+        self.env = outside_env()
         self.env.update(PATH=f"{bin}{os.pathsep}{os.environ['PATH']}", MERCMAC_DATA_DIR=str(data))
         self.bin = bin
 
@@ -199,6 +213,7 @@ def first_setup_sim() -> str:
 
 
 @pytest.mark.slow
+@RELEASE
 def test_the_installed_wheel_runs_the_readme(installed, tmp_path):
     home = tmp_path / "empty"
     home.mkdir()
