@@ -108,12 +108,11 @@ def run_version(version: str, root: Path, args: list[str]) -> tuple[str, bool]:
 
 
 def chosen_versions(text: str | None, others: bool) -> list[str]:
-    """--versions as a list (each one supported), less this interpreter's with --others."""
+    """--versions as a list, less this interpreter's with --others; ValueError if unsupported."""
     versions = list(SUPPORTED) if text is None else [v.strip() for v in text.split(",") if v.strip()]
     unknown = [v for v in versions if v not in SUPPORTED]
     if unknown:
-        raise SystemExit(f"pythons.py: {', '.join(unknown)} not among the supported "
-                         f"{', '.join(SUPPORTED)}")
+        raise ValueError(f"{', '.join(unknown)} not among the supported {', '.join(SUPPORTED)}")
     this = "{}.{}".format(*sys.version_info[:2])
     return [v for v in versions if not (others and v == this)]
 
@@ -127,9 +126,16 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--others", action="store_true",
                         help="leave out the version running this script (CI tested it already)")
     options = parser.parse_args(argv[:split])
+    try:
+        versions = chosen_versions(options.versions, options.others)
+    except ValueError as error:
+        parser.error(str(error))  # exits 2
     root = pyenv_root()
-    results = [run_version(v, root, argv[split + 1:])
-               for v in chosen_versions(options.versions, options.others)]
+    try:
+        results = [run_version(v, root, argv[split + 1:]) for v in versions]
+    except KeyboardInterrupt:  # pytest, in the same process group, had the Ctrl-C too
+        print("\npythons.py: interrupted", file=sys.stderr)
+        return 130
     print("--- per Python version:")
     for line, _ in results:
         print(line)

@@ -72,9 +72,12 @@ def test_pyenv_root_follows_pyenv_root_env(tmp_path, monkeypatch):
     assert pythons.pyenv_root() == tmp_path
 
 
-def test_unknown_versions_are_refused_and_others_leaves_this_one_out():
-    with pytest.raises(SystemExit, match="3.9 not among the supported"):
+def test_unknown_versions_are_a_usage_error_and_others_leaves_this_one_out():
+    with pytest.raises(ValueError, match="3.9 not among the supported"):
         pythons.chosen_versions("3.12,3.9", others=False)
+    with pytest.raises(SystemExit) as usage:
+        pythons.main(["--versions", "3.9"])
+    assert usage.value.code == 2
     assert pythons.chosen_versions(" 3.13 ,3.12", others=False) == ["3.13", "3.12"]
     assert THIS not in pythons.chosen_versions(None, others=True)
     assert len(pythons.chosen_versions(None, others=True)) == len(pythons.SUPPORTED) - 1
