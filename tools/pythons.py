@@ -6,8 +6,9 @@
 Each version's interpreter is the newest `X.Y.N` under `$(pyenv root)/versions/`; a version
 that is not there is skipped, saying so. Its venv is `.venvs/pyX.Y` (git-ignored), where
 `.[test]` is installed again whenever pyproject.toml changes. The arguments after `--` go to
-`python -m pytest`. One line per version closes the run; the exit code is 1 if any version's
-install or tests failed, else 0. Standard library only: it runs before any venv exists.
+`python -m pytest`. One line per version closes the run. Exit code: 1 if any version's install
+or tests failed, else 0 (2: a usage error; 130: Ctrl-C). Standard library only: it runs before
+any venv exists. The tests import mercmac from this tree, as the README's test command does.
 """
 from __future__ import annotations
 
