@@ -66,15 +66,25 @@ def test_lsp_help_names_stdio():
     assert out.returncode == 0 and "--stdio" in out.stdout
 
 
-def _in_a_terminal(args: list[str]) -> tuple[int, int]:
-    """Start `args` on a new pseudo-terminal, Ctrl-C at its default: (pid, terminal fd)."""
-    import pty
+# The child of _in_a_terminal: a new session whose controlling terminal is its stdin, Ctrl-C
+# at its default, then `args`. A fresh Python does it, not pty.fork(): Python code run in a fork
+# of this multi-threaded worker may deadlock (Python 3.12+ warns of forkpty: DeprecationWarning).
+_LOGIN = """import fcntl, os, signal, sys, termios
+fcntl.ioctl(0, termios.TIOCSCTTY, 0)
+signal.signal(signal.SIGINT, signal.SIG_DFL)  # a background job's shell ignores it
+os.execv(sys.argv[1], sys.argv[1:])
+"""
 
-    pid, fd = pty.fork()
-    if pid == 0:  # the child: the terminal is its stdin, stdout and stderr
-        _default_sigint()
-        os.execv(args[0], args)
-    return pid, fd
+
+def _in_a_terminal(args: list[str]) -> tuple[subprocess.Popen, int]:
+    """Start `args` on a new pseudo-terminal, Ctrl-C at its default: (process, terminal fd)."""
+    fd, terminal = os.openpty()
+    try:  # the terminal is its stdin, stdout and stderr
+        process = subprocess.Popen([sys.executable, "-c", _LOGIN, *args], stdin=terminal,
+                                   stdout=terminal, stderr=terminal, start_new_session=True)
+    finally:
+        os.close(terminal)
+    return process, fd
 
 
 def _read_until(fd: int, wanted: bytes, wait_s: float = WAIT_S) -> bytes:
@@ -93,18 +103,15 @@ def _read_until(fd: int, wanted: bytes, wait_s: float = WAIT_S) -> bytes:
     return shown
 
 
-def _exit_code(pid: int, wait_s: float = WAIT_S) -> int | None:
-    end = time.monotonic() + wait_s
-    while time.monotonic() < end:
-        done, status = os.waitpid(pid, os.WNOHANG)
-        if done:
-            return os.waitstatus_to_exitcode(status)
-        time.sleep(0.05)
-    return None
+def _exit_code(process: subprocess.Popen, wait_s: float = WAIT_S) -> int | None:
+    try:
+        return process.wait(timeout=wait_s)
+    except subprocess.TimeoutExpired:
+        return None
 
 
 def test_in_a_terminal_it_says_what_it_waits_for_and_the_first_ctrl_c_ends_it():
-    pid, fd = _in_a_terminal(SERVER)
+    process, fd = _in_a_terminal(SERVER)
     code = None
     try:
         shown = _read_until(fd, b"Ctrl-C quits.", wait_s=5.0)
@@ -112,13 +119,13 @@ def test_in_a_terminal_it_says_what_it_waits_for_and_the_first_ctrl_c_ends_it():
         assert b"stdin/stdout" in shown and b"Ctrl-C quits." in shown, shown
         os.write(fd, b"\x03")  # the terminal's Ctrl-C: SIGINT to the foreground process
         shown += _read_until(fd, b"interrupted")
-        code = _exit_code(pid)
+        code = _exit_code(process)
         assert code == 130, (code, shown)
         assert b"Fatal Python error" not in shown and b"Traceback" not in shown
     finally:
         if code is None:
-            os.kill(pid, signal.SIGKILL)
-            os.waitpid(pid, 0)
+            process.kill()
+            process.wait()
         os.close(fd)
 
 
