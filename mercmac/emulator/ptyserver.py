@@ -40,6 +40,7 @@ class PtyServer:
         self.path = os.ttyname(self._slave)
         self._stop = threading.Event()
         self._lock = threading.Lock()
+        self._busy = False  # between reading the host's bytes and writing the answer (idle())
         self._thread: threading.Thread | None = None
         self._t0 = time.monotonic()
         self._failures: set[str] = set()  # logged once each, however often they recur
@@ -61,19 +62,30 @@ class PtyServer:
         self._thread.start()
 
     def serve_forever(self) -> None:
-        while not self._stop.is_set() and self._master is not None:
-            ready, _, _ = select.select([self._master], [], [], TICK_S)
-            now = time.monotonic() - self._t0
-            data = self._read() if ready else b""
-            with self._lock:
-                out, vanished = self._serve(data, now)
-            if data:
-                self._record(now, "->", data, self._selection())
-            if out:
-                self._send(out, time.monotonic() - self._t0)
-            if vanished:
+        # The fds are closed by this thread only (here, or by close() once it has ended):
+        # closed under a running select or read, they would be None or another file's.
+        try:
+            while not self._stop.is_set():
+                if self._turn():
+                    break
+        finally:
+            if self._thread is None or self._thread is threading.current_thread():
                 self._close_fds()
-                return
+
+    def _turn(self) -> bool:
+        """Read what the host sent, serve it, send the answer; whether the port vanished."""
+        ready, _, _ = select.select([self._master], [], [], TICK_S)
+        self._busy = bool(ready)  # set before the read: idle() never sees the bytes nowhere
+        now = time.monotonic() - self._t0
+        data = self._read() if ready else b""
+        with self._lock:
+            out, vanished = self._serve(data, now)
+        if data:
+            self._record(now, "->", data, self._selection())
+        if out:
+            self._send(out, time.monotonic() - self._t0)
+        self._busy = False
+        return vanished
 
     def _serve(self, data: bytes, now: float) -> tuple[bytes, bool]:
         """One turn of the controller; a bug in it is logged, and serving goes on."""
@@ -95,10 +107,28 @@ class PtyServer:
             return fn(self.controller)
 
     def close(self) -> None:
+        """Stop serving; the serving thread closes the pty as it ends (never under its feet)."""
         self._stop.set()
-        if self._thread and self._thread is not threading.current_thread():
-            self._thread.join(timeout=2)
-        self._close_fds()
+        if self._thread is None:
+            self._close_fds()
+        elif self._thread is not threading.current_thread():
+            self._thread.join()  # one turn: at most TICK_S in select, then out
+
+    def idle(self) -> bool:
+        """Whether nothing is in flight on the line: every byte the host sent is served and
+        every answer is read. A test's clock runs only then (tests/helpers/emulator.py)."""
+        # In this order: bytes leave the master's queue only after _busy is set, and _busy
+        # is cleared only after the answer is in the slave's queue. select, not FIONREAD:
+        # a pty passes bytes on in a kernel worker, which poll() waits for and FIONREAD not.
+        master, slave = self._master, self._slave
+        if master is None or slave is None:
+            return True
+        try:
+            if _readable(master) or self._busy or _readable(slave):
+                return False
+        except (OSError, ValueError):  # closed meanwhile: the line is gone, nothing in flight
+            pass
+        return True
 
     def _what(self) -> str:
         """The header's words for what is served: a controller, or a chain by address."""
@@ -136,6 +166,7 @@ class PtyServer:
             self._log = None
 
     def _read(self) -> bytes:
+        # os.read, not select's fd: closing is this thread's, so _master is open here
         try:
             return os.read(self._master, 4096)
         except OSError:
@@ -169,3 +200,8 @@ class PtyServer:
                 except OSError:
                     pass
                 setattr(self, name, None)
+
+
+def _readable(fd: int) -> bool:
+    """Whether fd has bytes to read, without reading them."""
+    return bool(select.select([fd], [], [], 0)[0])
