@@ -18,7 +18,7 @@ from mercmac.compiler.program import Op
 from mercmac.emulator.virtual import Faults
 from mercmac.upload import protocol
 from mercmac.vm import Machine, Options, reports
-from helpers.emulator import basil_mercury, eventually, raw_port, read_for, serve
+from helpers.emulator import FAST, basil_mercury, drain, eventually, raw_port, read_for, serve
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs pseudo-terminals")
 
@@ -159,7 +159,7 @@ def test_a_hit_limit_switch_drives_its_line_to_its_active_level(model, block, ne
 def test_an_unknown_model_goes_on_as_the_files_target(tmp_path, program_file):
     with serve(faults=Faults(version=OLD_VE)) as (server, vc):
         result = cli("flash", server.path, program_file, "--backup", tmp_path / "b.mcm",
-                     "--timeout", "0.3")
+                     *FAST)
     assert result.exit_code == 0, result.output
     assert "C-862" in result.output and "going on as the C-863" in result.output
     assert vc.macros == {5: "MR5000,WS100"}
@@ -170,7 +170,7 @@ def test_an_unknown_model_goes_on_as_the_target_option(tmp_path):
     prog.write_text("[MC05] MR5000,WS100\n")
     with serve(faults=Faults(version=OLD_VE)) as (server, vc):
         result = cli("flash", server.path, prog, "--target", "C-663", "--backup",
-                     tmp_path / "b.mcm", "--timeout", "0.3")
+                     tmp_path / "b.mcm", *FAST)
     assert result.exit_code == 0, result.output
     assert "going on as the C-663" in result.output and vc.macros == {5: "MR5000,WS100"}
 
@@ -180,7 +180,7 @@ def test_an_unknown_model_without_any_target_is_refused_saying_what_ve_answered(
     prog.write_text("[MC05] MR5000,WS100\n")
     with serve(faults=Faults(version=OLD_VE)) as (server, vc):
         result = cli("flash", server.path, prog, "--backup", tmp_path / "b.mcm",
-                     "--timeout", "0.3")
+                     *FAST)
         assert result.exit_code == 1, result.output
         assert "C-862, Ver. 1.20" in result.output and "--target" in result.output
         assert "nothing was written" in result.output and vc.md_count == 0
@@ -188,7 +188,7 @@ def test_an_unknown_model_without_any_target_is_refused_saying_what_ve_answered(
 
 def test_pull_reads_a_controller_of_an_unknown_model(tmp_path):
     with serve(faults=Faults(version=OLD_VE), macros={5: "GH"}) as (server, vc):
-        result = cli("pull", server.path, "--timeout", "0.3")
+        result = cli("pull", server.path, *FAST)
     assert result.exit_code == 0, result.output
     assert "[MC05] GH" in result.output and "\ntarget " not in result.output
 
@@ -288,11 +288,10 @@ def test_emulate_refuses_a_log_that_is_not_a_regular_file(tmp_path, kind):
 @pytest.mark.parametrize("write_termination", ["", "\x03"])  # "\x03": basil's default, an ETX
 def test_basil_daq_mercury_driver(write_termination):
     with serve() as (server, vc):
-        with basil_mercury(server.path, write_termination) as dut:
+        with basil_mercury(server, write_termination) as dut:
             mercury = dut["Mercury"]
             assert 0 in mercury._board_numbers
-            time.sleep(0.05)
-            dut["Serial"]._port.reset_input_buffer()  # the second TB's answer it never reads
+            drain(dut["Serial"]._port)  # the second TB's answer, if basil has not read it
             assert mercury.get_board_number(0) == "B:0\r\n\x03"
             assert mercury.get_position(0) == 0
             mercury.motor_on(0)

@@ -40,8 +40,9 @@ def connect(server, address: int = 0, timing: Timing = FAST_TIMING):
 
 @contextmanager
 def raw_port(server):
-    """pyserial straight on the pty, for byte-level checks."""
+    """pyserial straight on the pty, for byte-level checks; read_for knows its server."""
     port = serial.serial_for_url(server.path, baudrate=9600, timeout=0.3)
+    port.mercmac_server = server
     try:
         yield port
     finally:
@@ -84,8 +85,12 @@ def line_clock(server: PtyServer, speed: float = 100.0):
             module.time = real
 
 
-def eventually(server, check, seconds: float = 1.0) -> bool:
-    """Whether check(controller) becomes true: the emulator reads bytes in its own thread."""
+ROOM_S = 20.0  # how long an event that comes at once on a quiet machine may take under load
+
+
+def eventually(server, check, seconds: float = ROOM_S) -> bool:
+    """Whether check(controller) becomes true: the emulator reads bytes in its own thread.
+    True as soon as it is; `seconds` is only a guard against a hang."""
     end = time.monotonic() + seconds
     while time.monotonic() < end:
         if server.call(check):
@@ -95,10 +100,16 @@ def eventually(server, check, seconds: float = 1.0) -> bool:
 
 
 def read_for(port, seconds: float = 0.15) -> bytes:
+    """What comes in `seconds`, and after them until the line is idle (a raw_port's server
+    has served every byte sent and every answer is read): a slow machine delays an answer,
+    never cuts it off. A running macro's reports that have not come by then are not read."""
+    server = getattr(port, "mercmac_server", None)
     end, data = time.monotonic() + seconds, b""
-    while time.monotonic() < end:
+    while True:
         data += port.read(port.in_waiting or 1)
-    return data
+        now = time.monotonic()
+        if now >= end and (server is None or server.idle() or now >= end + ROOM_S):
+            return data
 
 
 @contextmanager
@@ -120,20 +131,54 @@ def emulating(*args: str):
 
 
 @contextmanager
-def basil_mercury(path: str, write_termination: str):
-    """basil-daq's Dut with its Mercury driver on PATH over its pyserial transport, inited:
-    it probes boards 0-15 with two TBs each and reads one answer (skipped without basil)."""
+def basil_mercury(server: PtyServer, write_termination: str):
+    """basil-daq's Dut with its Mercury driver on SERVER's path over its pyserial transport,
+    inited: it probes boards 0-15 with two TBs each and reads one answer (skipped without
+    basil). Its reads end a silence when the line is idle (hears_silence), not after a
+    timeout: basil's own 0.05 s cut answers off under load, and seconds for each of the
+    silent boards would make the probe slow."""
     import pytest
 
     dut_module = pytest.importorskip("basil.dut", reason="basil-daq is not installed "
                                      "(pip install '.[test]' installs it)")
     conf = {"transfer_layer": [{"name": "Serial", "type": "Serial", "init": {
-                "port": path, "baudrate": 9600, "timeout": 0.05,
+                "port": server.path, "baudrate": 9600, "timeout": SLICE_S,
                 "read_termination": "\x03", "write_termination": write_termination}}],
             "hw_drivers": [{"name": "Mercury", "type": "mercury", "interface": "Serial"}]}
     dut = dut_module.Dut(conf)
+    serial_layer = dut["Serial"]
+    opened = serial_layer.init  # opens its pyserial port, before the driver's probe
+
+    def init() -> None:
+        opened()
+        hears_silence(serial_layer._port, server)
+    serial_layer.init = init
     dut.init()
     try:
         yield dut
     finally:
         dut.close()
+
+
+SLICE_S = 0.02  # one pyserial read of a host that hears_silence
+
+
+def hears_silence(port, server: PtyServer) -> None:
+    """PORT's reads (pyserial, timeout SLICE_S) wait while bytes are in flight to or from
+    SERVER and return empty once the line is idle: a silence, whatever the machine's speed."""
+    read = port.read
+
+    def read_until_idle(size: int = 1) -> bytes:
+        while True:
+            data = read(size)
+            if data or server.idle():  # idle after the read: an answer since is not lost
+                return data
+    port.read = read_until_idle
+
+
+def drain(port) -> bytes:
+    """Every answer still on its way to a port that hears_silence, read."""
+    data = b""
+    while chunk := port.read(4096):
+        data += chunk
+    return data
