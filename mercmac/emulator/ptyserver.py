@@ -14,7 +14,7 @@ import select
 import threading
 import time
 import tty
-from typing import IO
+from typing import IO, Callable
 
 from mercmac.emulator.chain import Chain
 from mercmac.emulator.virtual import VirtualController
@@ -29,7 +29,8 @@ class PtyServer:
     """A VirtualController (or a Chain of them) behind a pty; `path` is what to give
     `mercmac flash`."""
 
-    def __init__(self, controller: VirtualController | Chain, log: IO[str] | None = None):
+    def __init__(self, controller: VirtualController | Chain, log: IO[str] | None = None,
+                 clock: Callable[[], float] = time.monotonic):
         if not hasattr(os, "openpty"):
             raise OSError("pseudo-terminals need a POSIX system (Linux, macOS)")
         self.controller = controller  # what `call` hands over
@@ -42,7 +43,8 @@ class PtyServer:
         self._lock = threading.Lock()
         self._busy = False  # between reading the host's bytes and writing the answer (idle())
         self._thread: threading.Thread | None = None
-        self._t0 = time.monotonic()
+        self._clock = clock  # the controller's time: a test may hold it (typing speed tests)
+        self._t0 = clock()
         self._failures: set[str] = set()  # logged once each, however often they recur
         self._log = log  # `mercmac emulate --log`: the caller opens and closes it
         self._note(f"# {time.strftime('%Y-%m-%d %H:%M:%S %z')} {self._what()} on "
@@ -76,14 +78,14 @@ class PtyServer:
         """Read what the host sent, serve it, send the answer; whether the port vanished."""
         ready, _, _ = select.select([self._master], [], [], TICK_S)
         self._busy = bool(ready)  # set before the read: idle() never sees the bytes nowhere
-        now = time.monotonic() - self._t0
+        now = self._clock() - self._t0
         data = self._read() if ready else b""
         with self._lock:
             out, vanished = self._serve(data, now)
         if data:
             self._record(now, "->", data, self._selection())
         if out:
-            self._send(out, time.monotonic() - self._t0)
+            self._send(out, self._clock() - self._t0)
         self._busy = False
         return vanished
 
@@ -120,15 +122,19 @@ class PtyServer:
         # In this order: bytes leave the master's queue only after _busy is set, and _busy
         # is cleared only after the answer is in the slave's queue. select, not FIONREAD:
         # a pty passes bytes on in a kernel worker, which poll() waits for and FIONREAD not.
-        master, slave = self._master, self._slave
-        if master is None or slave is None:
-            return True
+        slave = self._slave
         try:
-            if _readable(master) or self._busy or _readable(slave):
-                return False
+            return self.served() and (slave is None or not _readable(slave))
         except (OSError, ValueError):  # closed meanwhile: the line is gone, nothing in flight
-            pass
-        return True
+            return True
+
+    def served(self) -> bool:
+        """Whether every byte the host sent has been read and answered (idle() says more)."""
+        master = self._master
+        try:
+            return master is None or not (_readable(master) or self._busy)
+        except (OSError, ValueError):
+            return True
 
     def _what(self) -> str:
         """The header's words for what is served: a controller, or a chain by address."""

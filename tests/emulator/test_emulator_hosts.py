@@ -18,7 +18,8 @@ from mercmac.compiler.program import Op
 from mercmac.emulator.virtual import Faults
 from mercmac.upload import protocol
 from mercmac.vm import Machine, Options, reports
-from helpers.emulator import FAST, basil_mercury, drain, eventually, raw_port, read_for, serve
+from helpers.emulator import (FAST, HeldClock, basil_mercury, drain, eventually, raw_port, read_for,
+                              serve, typed)
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs pseudo-terminals")
 
@@ -213,26 +214,29 @@ def test_paced_bytes_arrive_at_the_baud_rate():
 
 
 def test_paced_link_drops_a_line_typed_slower_than_20ms_whatever_the_firmware():
-    with serve(faults=Faults(pace=True), firmware="2.30") as (server, vc), raw_port(server) as port:
+    clock = HeldClock()  # the gaps on the emulator's clock, whatever the load
+    with serve(clock, faults=Faults(pace=True), firmware="2.30") as (server, vc), \
+            raw_port(server) as port:
         port.write(SELECT)
-        for ch in b"TB\r":
-            port.write(bytes([ch]))
-            time.sleep(0.03)
+        typed(server, port, b"TB\r", clock, 0.03)
+        clock.release()  # real time from here: an answer, if any, would be paced out
         assert read_for(port) == b""
         assert status(port).error == 0x01  # §6.4 TS: 01 RS-232 timeout
 
 
 def test_paced_link_loses_characters_typed_at_full_speed_during_a_move():
-    with serve(faults=Faults(pace=True)) as (server, vc), raw_port(server) as port:
-        port.write(SELECT + b"MR200000\r")  # about 4.5 s at the C-863's SV 45000
-        time.sleep(0.05)
-        port.write(b"TT\r")
+    clock = HeldClock()
+    with serve(clock, faults=Faults(pace=True)) as (server, vc), raw_port(server) as port:
+        typed(server, port, SELECT + b"MR200000\r", clock, 0)  # about 4.5 s at SV 45000
+        clock.advance(0.05)
+        typed(server, port, b"TT\r", clock, 0)  # at full speed: at one instant
+        clock.advance(0.05)  # time for an answer to be paced out, if there were one
         assert read_for(port) == b""  # 'T' taken, the next one lost: "T" + CR, error 06
         assert server.call(lambda v: v.lost) >= 1
-        assert ask(port, b"'")[0].startswith(b"P:")  # one character alone gets through
-        for ch in b"TT\r":  # 5 ms apart: slower than the receiver, faster than 20 ms
-            port.write(bytes([ch]))
-            time.sleep(0.005)
+        typed(server, port, b"'", clock, 0.05)
+        assert replies(port, 1)[0].startswith(b"P:")  # one character alone gets through
+        typed(server, port, b"TT\r", clock, 0.005)  # slower than the receiver, faster than 20 ms
+        clock.advance(0.05)
         assert replies(port, 1) == [b"T:+0000200000" + END]
 
 

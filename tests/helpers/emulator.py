@@ -24,12 +24,50 @@ FAST = ("--timeout", str(FAST_TIMING.timeout))
 
 
 @contextmanager
-def serve(**kw):
-    """A virtual controller on a pty: yields (server, controller)."""
+def serve(clock=time.monotonic, **kw):
+    """A virtual controller on a pty: yields (server, controller); `clock` is its time."""
     faults = kw.pop("faults", None) or Faults()
     vc = VirtualController(faults=faults, **kw)
-    with PtyServer(vc) as server:
+    with PtyServer(vc, clock=clock) as server:
         yield server, vc
+
+
+class HeldClock:
+    """The emulator's time as the test moves it (`advance`), until `release`d to run on as
+    real time: a typing-speed test types at the gaps it names, however loaded the machine."""
+
+    def __init__(self):
+        self._now, self._since = 0.0, None
+
+    def __call__(self) -> float:
+        if self._since is None:
+            return self._now
+        return self._now + time.monotonic() - self._since
+
+    def advance(self, seconds: float) -> None:
+        self._now += seconds
+
+    def release(self) -> None:
+        self._since = time.monotonic()
+
+
+def typed(server: PtyServer, port, text: bytes, clock: HeldClock, gap: float) -> None:
+    """TEXT written a byte at a time, `gap` seconds of CLOCK apart, each served before the
+    next; the clock runs on `gap` after the last byte too."""
+    for byte in text:
+        port.write(bytes([byte]))
+        assert until(server.served), "the emulator never read the byte"
+        clock.advance(gap)
+
+
+def until(condition, seconds: float = 20.0) -> bool:
+    """Whether CONDITION() becomes true (at once on a quiet machine); polls every 5 ms."""
+    end = time.monotonic() + seconds
+    while not condition():
+        if time.monotonic() >= end:
+            return False
+        time.sleep(0.005)
+    return True
 
 
 @contextmanager
