@@ -15,7 +15,7 @@ import pytest
 import serial
 
 from helpers.cli import cli
-from helpers.emulator import basil_mercury, drain, emulating, eventually, raw_port, read_for
+from helpers.emulator import ROOM_S, basil_mercury, drain, emulating, eventually, raw_port, read_for
 from mercmac.emulator import chain
 from mercmac.emulator.ptyserver import PtyServer
 from mercmac.emulator.virtual import StateError, VirtualController
@@ -32,7 +32,7 @@ def served(*controllers: VirtualController, log=None):
         yield server, server.controller
 
 
-def answers(port, data: bytes, n: int = 1, seconds: float = 2.0) -> list[bytes]:
+def answers(port, data: bytes, n: int = 1, seconds: float = ROOM_S) -> list[bytes]:
     port.write(data)
     got, end = b"", time.monotonic() + seconds
     while got.count(b"\x03") < n and time.monotonic() < end:
@@ -59,7 +59,7 @@ def test_a_deselected_controller_ignores_commands_and_its_macro_keeps_running():
         port.write(select(1) + b"EM1\r" + select(0) + b"MA777\r")  # MA: x, and y runs on
         assert eventually(server, lambda c: c.by_address(0).machine.target == 777)
         seen = set()
-        end = time.monotonic() + 1.5
+        end = time.monotonic() + ROOM_S
         while len(seen) < 5 and time.monotonic() < end:  # y moves while x is selected
             seen.add(server.call(lambda c: c.by_address(1).machine.position()))
             time.sleep(0.02)

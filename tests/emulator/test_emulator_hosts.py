@@ -18,8 +18,8 @@ from mercmac.compiler.program import Op
 from mercmac.emulator.virtual import Faults
 from mercmac.upload import protocol
 from mercmac.vm import Machine, Options, reports
-from helpers.emulator import (FAST, HeldClock, basil_mercury, drain, eventually, raw_port, read_for,
-                              serve, typed)
+from helpers.emulator import (FAST, ROOM_S, HeldClock, basil_mercury, drain, eventually, raw_port, read_for,
+                              serve, typed, until)
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs pseudo-terminals")
 
@@ -29,7 +29,7 @@ OLD_VE = "(c)2003 Physik Instrumente(PI) Karlsruhe, C-862, Ver. 1.20, 2003-05-10
 PROGRAM = "target C-863\n[MC05] MR5000,WS100\n"
 
 
-def replies(port, n: int, seconds: float = 2.0) -> list[bytes]:
+def replies(port, n: int, seconds: float = ROOM_S) -> list[bytes]:
     """The next n reports as they came, each with its CR LF ETX (fewer if they do not come)."""
     data, end = b"", time.monotonic() + seconds
     while data.count(b"\x03") < n and time.monotonic() < end:
@@ -98,8 +98,8 @@ def test_an_etx_after_each_cr_is_ignored():
                                                               b"T:+0000000000" + END]
         assert status(port, b"TS\r\x03").error == 0
         port.write(b"EM3\r\x03")  # the ETX must not stop the macro it just started
-        time.sleep(0.1)
-        assert server.call(lambda v: v.machine.macro) == 3
+        assert until(server.served)  # both read
+        assert eventually(server, lambda v: v.machine.macro == 3)
 
 
 # -- TS: "macro running" and the error code -------------------------------------------------

@@ -32,6 +32,14 @@ def serve(clock=time.monotonic, **kw):
         yield server, vc
 
 
+@contextmanager
+def serve_clocked(**kw):
+    """serve, with mercmac's timeouts in this process on the line's clock (line_clock): for a
+    controller that answers at once or never (no md_delay), where silences are waited out."""
+    with serve(**kw) as (server, vc), line_clock(server):
+        yield server, vc
+
+
 class HeldClock:
     """The emulator's time as the test moves it (`advance`), until `release`d to run on as
     real time: a typing-speed test types at the gaps it names, however loaded the machine."""
