@@ -77,7 +77,7 @@ class PtyServer:
     def _turn(self) -> bool:
         """Read what the host sent, serve it, send the answer; whether the port vanished."""
         ready, _, _ = select.select([self._master], [], [], TICK_S)
-        self._busy = bool(ready)  # set before the read: idle() never sees the bytes nowhere
+        self._busy = True  # before the read, until the answer is sent: see served()
         now = self._clock() - self._t0
         data = self._read() if ready else b""
         with self._lock:
@@ -119,9 +119,6 @@ class PtyServer:
     def idle(self) -> bool:
         """Whether nothing is in flight on the line: every byte the host sent is served and
         every answer is read. A test's clock runs only then (tests/helpers/emulator.py)."""
-        # In this order: bytes leave the master's queue only after _busy is set, and _busy
-        # is cleared only after the answer is in the slave's queue. select, not FIONREAD:
-        # a pty passes bytes on in a kernel worker, which poll() waits for and FIONREAD not.
         slave = self._slave
         try:
             return self.served() and (slave is None or not _readable(slave))
@@ -129,7 +126,24 @@ class PtyServer:
             return True
 
     def served(self) -> bool:
-        """Whether every byte the host sent has been read and answered (idle() says more)."""
+        """Whether every byte the host sent has been read and answered (idle() says more):
+        none waits in the pty, in a turn of this server, or in a controller busy with a line."""
+        # Checked in the order a byte goes: the master's queue, a turn (_busy is set before
+        # the read), a controller's input (filled in that turn), the turn that takes it from
+        # there and sends the answer (_busy again, cleared after the send). Each stage
+        # overlaps the next, so checks in this order cannot all miss a byte on its way.
+        # select, not FIONREAD: a pty passes bytes on in a kernel worker, which poll() waits
+        # for and FIONREAD does not.
+        if not self.received():
+            return False
+        with self._lock:
+            if any(c.waiting for c in self.chain.controllers):
+                return False
+        return not self._busy
+
+    def received(self) -> bool:
+        """Whether every byte the host sent has been handed to the controllers (served()
+        says whether they have read it)."""
         master = self._master
         try:
             return master is None or not (_readable(master) or self._busy)

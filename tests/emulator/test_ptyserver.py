@@ -7,7 +7,7 @@ import threading
 
 import pytest
 
-from helpers.emulator import eventually, raw_port, serve
+from helpers.emulator import eventually, raw_port, serve, until
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs pseudo-terminals")
 
@@ -44,9 +44,9 @@ def test_close_during_a_long_turn_waits_for_it(thread_errors):
 
 def test_idle_is_false_while_the_host_has_an_answer_to_read():
     with serve() as (server, vc), raw_port(server) as port:
-        assert server.idle()
+        assert until(server.idle)
         port.write(b"\x010TP\r")
         assert eventually(server, lambda _c: "TP" in _c.lines, seconds=WAIT_S)
         assert not server.idle()  # "P:+0000000000" waits in the pty for the host
         assert port.read_until(b"\x03").endswith(b"\x03")
-        assert server.idle()
+        assert until(server.idle)

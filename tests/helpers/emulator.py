@@ -60,11 +60,11 @@ class HeldClock:
 
 
 def typed(server: PtyServer, port, text: bytes, clock: HeldClock, gap: float) -> None:
-    """TEXT written a byte at a time, `gap` seconds of CLOCK apart, each served before the
-    next; the clock runs on `gap` after the last byte too."""
+    """TEXT written a byte at a time, `gap` seconds of CLOCK apart, each taken by the server
+    before the next; the clock runs on `gap` after the last byte too."""
     for byte in text:
         port.write(bytes([byte]))
-        assert until(server.served), "the emulator never read the byte"
+        assert until(server.received), "the emulator never took the byte"
         clock.advance(gap)
 
 
