@@ -41,7 +41,7 @@ class PtyServer:
         self.path = os.ttyname(self._slave)
         self._stop = threading.Event()
         self._lock = threading.Lock()
-        self._busy = False  # between reading the host's bytes and writing the answer (idle())
+        self._busy = False  # a turn runs: from before its read to after its send (served())
         self._thread: threading.Thread | None = None
         self._clock = clock  # the controller's time: a test may hold it (typing speed tests)
         self._t0 = clock()
@@ -186,7 +186,7 @@ class PtyServer:
             self._log = None
 
     def _read(self) -> bytes:
-        # os.read, not select's fd: closing is this thread's, so _master is open here
+        # _master is open here: only the serving thread closes it (serve_forever)
         try:
             return os.read(self._master, 4096)
         except OSError:

@@ -21,6 +21,7 @@ from mercmac.upload.transport import Timing
 # time stays short: a TM listing comes in one write of the emulator.
 FAST_TIMING = Timing(timeout=5.0, settle=0.05)
 FAST = ("--timeout", str(FAST_TIMING.timeout))
+ROOM_S = 20.0  # how long an event that comes at once on a quiet machine may take under load
 
 
 @contextmanager
@@ -68,8 +69,8 @@ def typed(server: PtyServer, port, text: bytes, clock: HeldClock, gap: float) ->
         clock.advance(gap)
 
 
-def until(condition, seconds: float = 20.0) -> bool:
-    """Whether CONDITION() becomes true (at once on a quiet machine); polls every 5 ms."""
+def until(condition, seconds: float = ROOM_S) -> bool:
+    """Whether CONDITION() becomes true, as soon as it is; `seconds` only guards a hang."""
     end = time.monotonic() + seconds
     while not condition():
         if time.monotonic() >= end:
@@ -131,18 +132,9 @@ def line_clock(server: PtyServer, speed: float = 100.0):
             module.time = real
 
 
-ROOM_S = 20.0  # how long an event that comes at once on a quiet machine may take under load
-
-
 def eventually(server, check, seconds: float = ROOM_S) -> bool:
-    """Whether check(controller) becomes true: the emulator reads bytes in its own thread.
-    True as soon as it is; `seconds` is only a guard against a hang."""
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        if server.call(check):
-            return True
-        time.sleep(0.005)
-    return False
+    """Whether check(controller) becomes true: the emulator reads bytes in its own thread."""
+    return until(lambda: server.call(check), seconds)
 
 
 def read_for(port, seconds: float = 0.15) -> bytes:
