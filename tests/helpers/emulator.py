@@ -132,6 +132,24 @@ def line_clock(server: PtyServer, speed: float = 100.0):
             module.time = real
 
 
+def timeouts(monkeypatch) -> list[str]:
+    """The reads of mercmac's transport that wait out a silence from now on in this process,
+    each as its message, whatever the machine's speed (not the quiet `settle` that ends
+    every TM listing)."""
+    seen: list[str] = []
+    read_report = transport_module.Transport.read_report
+
+    def counted(self, timeout=None, deadline=None):
+        try:
+            return read_report(self, timeout, deadline)
+        except transport_module.ReadTimeout as e:
+            if timeout != self.timing.settle:
+                seen.append(str(e))
+            raise
+    monkeypatch.setattr(transport_module.Transport, "read_report", counted)
+    return seen
+
+
 def eventually(server, check, seconds: float = ROOM_S) -> bool:
     """Whether check(controller) becomes true: the emulator reads bytes in its own thread."""
     return until(lambda: server.call(check), seconds)
