@@ -101,6 +101,7 @@ def main() -> int:
         return 2
     command = readme_test_command()
     folder = Path(tempfile.mkdtemp(prefix="mercmac-loaded-"))
+    folder.chmod(0o755)  # as a clone of a user's: the tests that run as nobody read it
     clone = fresh_clone(folder)
     what = "no load" if args.quiet else f"stress-ng --cpu {args.cpu} on {os.cpu_count()} cores"
     print(f"{command}\n  in a fresh clone ({clone}), {args.runs} runs, {what}", flush=True)
