@@ -43,31 +43,39 @@ def fresh_clone(into: Path) -> Path:
 
 
 def start_load(cpus: int) -> subprocess.Popen:
-    """stress-ng on `cpus` workers, in its own process group (stopped by stop_load)."""
+    """stress-ng on `cpus` workers, in a session of its own (stopped by stop_group)."""
     return subprocess.Popen(["stress-ng", "--cpu", str(cpus), "--quiet"],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                             start_new_session=True)
 
 
-def stop_load(load: subprocess.Popen) -> None:
+def stop_group(process: subprocess.Popen) -> None:
+    """Stop a process started in a session of its own, and everything it started."""
     try:
-        os.killpg(load.pid, signal.SIGTERM)
+        os.killpg(process.pid, signal.SIGTERM)
     except ProcessLookupError:
         return
     try:
-        load.wait(timeout=30)
+        process.wait(timeout=30)
     except subprocess.TimeoutExpired:
-        os.killpg(load.pid, signal.SIGKILL)
-        load.wait()
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
 
 
 def run_once(clone: Path, command: str, log: Path) -> tuple[float, int, str]:
     """Wall seconds, exit code and output of one run of `command` in the clone."""
     started = time.monotonic()
     with log.open("w", encoding="utf-8") as out:
-        done = subprocess.run(["bash", "-c", command + " --durations=10"], cwd=clone,
-                              stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
-    return time.monotonic() - started, done.returncode, log.read_text(encoding="utf-8")
+        # a session of its own: stopped, the run takes its pytest workers with it
+        run = subprocess.Popen(["bash", "-c", command + " --durations=10"], cwd=clone,
+                               stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                               start_new_session=True)
+        try:
+            code = run.wait()
+        except BaseException:
+            stop_group(run)
+            raise
+    return time.monotonic() - started, code, log.read_text(encoding="utf-8")
 
 
 def report(number: int, seconds: float, code: int, output: str) -> None:
@@ -114,7 +122,7 @@ def main() -> int:
             failures += code != 0
     finally:
         if load:
-            stop_load(load)
+            stop_group(load)
         if args.keep or failures:
             print(f"logs and clone kept in {folder}")
         else:
