@@ -16,6 +16,11 @@ from helpers.paths import EXAMPLES
 # signal to the default in each child (an ignored one would stay ignored).
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+# The same for SIGHUP under `nohup` (tools/loaded_suite.py runs so): the tests that hang up a
+# mercmac could not. A handler that does nothing keeps this process alive on a hangup, as
+# nohup means, while each child starts with the default again.
+if hasattr(signal, "SIGHUP") and signal.getsignal(signal.SIGHUP) is signal.SIG_IGN:
+    signal.signal(signal.SIGHUP, lambda signum, frame: None)
 
 # Half of the suite's time is spent waiting on timeouts (a silent controller, a process that
 # must not answer), not computing, so more workers than cores pay: on 2 cores the pty and

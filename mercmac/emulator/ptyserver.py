@@ -14,7 +14,7 @@ import select
 import threading
 import time
 import tty
-from typing import IO
+from typing import IO, Callable
 
 from mercmac.emulator.chain import Chain
 from mercmac.emulator.virtual import VirtualController
@@ -29,7 +29,8 @@ class PtyServer:
     """A VirtualController (or a Chain of them) behind a pty; `path` is what to give
     `mercmac flash`."""
 
-    def __init__(self, controller: VirtualController | Chain, log: IO[str] | None = None):
+    def __init__(self, controller: VirtualController | Chain, log: IO[str] | None = None,
+                 clock: Callable[[], float] = time.monotonic):
         if not hasattr(os, "openpty"):
             raise OSError("pseudo-terminals need a POSIX system (Linux, macOS)")
         self.controller = controller  # what `call` hands over
@@ -40,8 +41,10 @@ class PtyServer:
         self.path = os.ttyname(self._slave)
         self._stop = threading.Event()
         self._lock = threading.Lock()
+        self._busy = False  # a turn runs: from before its read to after its send (served())
         self._thread: threading.Thread | None = None
-        self._t0 = time.monotonic()
+        self._clock = clock  # the controller's time: a test may hold it (typing speed tests)
+        self._t0 = clock()
         self._failures: set[str] = set()  # logged once each, however often they recur
         self._log = log  # `mercmac emulate --log`: the caller opens and closes it
         self._note(f"# {time.strftime('%Y-%m-%d %H:%M:%S %z')} {self._what()} on "
@@ -61,19 +64,30 @@ class PtyServer:
         self._thread.start()
 
     def serve_forever(self) -> None:
-        while not self._stop.is_set() and self._master is not None:
-            ready, _, _ = select.select([self._master], [], [], TICK_S)
-            now = time.monotonic() - self._t0
-            data = self._read() if ready else b""
-            with self._lock:
-                out, vanished = self._serve(data, now)
-            if data:
-                self._record(now, "->", data, self._selection())
-            if out:
-                self._send(out, time.monotonic() - self._t0)
-            if vanished:
+        # The fds are closed by this thread only (here, or by close() once it has ended):
+        # closed under a running select or read, they would be None or another file's.
+        try:
+            while not self._stop.is_set():
+                if self._turn():
+                    break
+        finally:
+            if self._thread is None or self._thread is threading.current_thread():
                 self._close_fds()
-                return
+
+    def _turn(self) -> bool:
+        """Read what the host sent, serve it, send the answer; whether the port vanished."""
+        ready, _, _ = select.select([self._master], [], [], TICK_S)
+        self._busy = True  # before the read, until the answer is sent: see served()
+        now = self._clock() - self._t0
+        data = self._read() if ready else b""
+        with self._lock:
+            out, vanished = self._serve(data, now)
+        if data:
+            self._record(now, "->", data, self._selection())
+        if out:
+            self._send(out, self._clock() - self._t0)
+        self._busy = False
+        return vanished
 
     def _serve(self, data: bytes, now: float) -> tuple[bytes, bool]:
         """One turn of the controller; a bug in it is logged, and serving goes on."""
@@ -95,10 +109,46 @@ class PtyServer:
             return fn(self.controller)
 
     def close(self) -> None:
+        """Stop serving; the serving thread closes the pty as it ends (never under its feet)."""
         self._stop.set()
-        if self._thread and self._thread is not threading.current_thread():
-            self._thread.join(timeout=2)
-        self._close_fds()
+        if self._thread is None:
+            self._close_fds()
+        elif self._thread is not threading.current_thread():
+            self._thread.join()  # one turn: at most TICK_S in select, then out
+
+    def idle(self) -> bool:
+        """Whether nothing is in flight on the line: every byte the host sent is served and
+        every answer is read. A test's clock runs only then (tests/helpers/emulator.py)."""
+        slave = self._slave
+        try:
+            return self.served() and (slave is None or not _readable(slave))
+        except (OSError, ValueError):  # closed meanwhile: the line is gone, nothing in flight
+            return True
+
+    def served(self) -> bool:
+        """Whether every byte the host sent has been read and answered (idle() says more):
+        none waits in the pty, in a turn of this server, or in a controller busy with a line."""
+        # Checked in the order a byte goes: the master's queue, a turn (_busy is set before
+        # the read), a controller's input (filled in that turn), the turn that takes it from
+        # there and sends the answer (_busy again, cleared after the send). Each stage
+        # overlaps the next, so checks in this order cannot all miss a byte on its way.
+        # select, not FIONREAD: a pty passes bytes on in a kernel worker, which poll() waits
+        # for and FIONREAD does not.
+        if not self.received():
+            return False
+        with self._lock:
+            if any(c.waiting for c in self.chain.controllers):
+                return False
+        return not self._busy
+
+    def received(self) -> bool:
+        """Whether every byte the host sent has been handed to the controllers (served()
+        says whether they have read it)."""
+        master = self._master
+        try:
+            return master is None or not (_readable(master) or self._busy)
+        except (OSError, ValueError):
+            return True
 
     def _what(self) -> str:
         """The header's words for what is served: a controller, or a chain by address."""
@@ -136,6 +186,7 @@ class PtyServer:
             self._log = None
 
     def _read(self) -> bytes:
+        # _master is open here: only the serving thread closes it (serve_forever)
         try:
             return os.read(self._master, 4096)
         except OSError:
@@ -169,3 +220,8 @@ class PtyServer:
                 except OSError:
                     pass
                 setattr(self, name, None)
+
+
+def _readable(fd: int) -> bool:
+    """Whether fd has bytes to read, without reading them."""
+    return bool(select.select([fd], [], [], 0)[0])

@@ -244,21 +244,21 @@ def programs(draw):
             f"macro a {pin}{{\n{body}\n}}\n")
 
 
-@settings(max_examples=budget(100), deadline=3000, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=budget(100), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(programs())
 def test_hostile_programs_never_raise(text):
     for d in diagnostics(text):
         assert d.span.line >= 1 and d.span.column >= 1
 
 
-@settings(max_examples=budget(150), deadline=3000, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=budget(150), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(mangled())
 def test_mangled_text_never_raises(text):
     for d in diagnostics(text):
         assert d.span.line >= 1 and d.span.column >= 1
 
 
-@settings(max_examples=budget(60), deadline=3000, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=budget(60), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.binary(max_size=400), st.sampled_from(["text", "json"]))
 def test_check_on_random_bytes_never_raises(data, fmt):
     r = CliRunner().invoke(main, ["check", "--format", fmt, "-"], input=data)

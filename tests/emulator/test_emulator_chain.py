@@ -15,7 +15,7 @@ import pytest
 import serial
 
 from helpers.cli import cli
-from helpers.emulator import basil_mercury, emulating, eventually, raw_port, read_for
+from helpers.emulator import ROOM_S, basil_mercury, drain, emulating, eventually, raw_port, read_for
 from mercmac.emulator import chain
 from mercmac.emulator.ptyserver import PtyServer
 from mercmac.emulator.virtual import StateError, VirtualController
@@ -32,7 +32,7 @@ def served(*controllers: VirtualController, log=None):
         yield server, server.controller
 
 
-def answers(port, data: bytes, n: int = 1, seconds: float = 2.0) -> list[bytes]:
+def answers(port, data: bytes, n: int = 1, seconds: float = ROOM_S) -> list[bytes]:
     port.write(data)
     got, end = b"", time.monotonic() + seconds
     while got.count(b"\x03") < n and time.monotonic() < end:
@@ -59,7 +59,7 @@ def test_a_deselected_controller_ignores_commands_and_its_macro_keeps_running():
         port.write(select(1) + b"EM1\r" + select(0) + b"MA777\r")  # MA: x, and y runs on
         assert eventually(server, lambda c: c.by_address(0).machine.target == 777)
         seen = set()
-        end = time.monotonic() + 1.5
+        end = time.monotonic() + ROOM_S
         while len(seen) < 5 and time.monotonic() < end:  # y moves while x is selected
             seen.add(server.call(lambda c: c.by_address(1).machine.position()))
             time.sleep(0.02)
@@ -149,18 +149,18 @@ def test_a_state_file_for_a_chain_is_refused(tmp_path):
 @pytest.mark.slow
 @pytest.mark.parametrize("write_termination", ["", "\x03"])  # "\x03": basil's default, an ETX
 def test_basil_daq_addresses_two_boards_on_one_port(write_termination):
-    with emulating("--addresses", "0,1") as (first, path), \
-            basil_mercury(path, write_termination) as dut:
+    with served(VirtualController(address=0), VirtualController(address=1)) as (server, c), \
+            basil_mercury(server, write_termination) as dut:
         mercury = dut["Mercury"]
         assert {0, 1} <= set(mercury._board_numbers)
-        time.sleep(0.05)
-        dut["Serial"]._port.reset_input_buffer()  # the second TBs' answers it never reads
+        drain(dut["Serial"]._port)  # the second TBs' answers, if basil has not read them
         assert mercury.get_board_number(0) == "B:0\r\n\x03"
         assert mercury.get_board_number(1) == "B:1\r\n\x03"
         mercury.motor_on(0)
         mercury.motor_on(1)
         mercury.set_position(400, board_number=0)
         mercury.set_position(-900, board_number=1)
-        time.sleep(0.3)  # both move at once, each on its own
+        assert eventually(server, lambda c: (c.by_address(0).machine.position(),  # both move
+                                             c.by_address(1).machine.position()) == (400, -900))
         assert mercury.get_position(0) == 400
         assert mercury.get_position(1) == -900

@@ -17,7 +17,7 @@ import pytest
 import serial
 
 from helpers.cli import cli
-from helpers.emulator import emulating, eventually, raw_port
+from helpers.emulator import ROOM_S, emulating, eventually, raw_port
 from helpers.paths import ROOT
 from mercmac.emulator import chain
 from mercmac.emulator.ptyserver import PtyServer
@@ -48,7 +48,7 @@ program = "y.mcm"
 def position(port, address: int) -> int:
     port.reset_input_buffer()
     port.write(select(address) + b"'")  # ' is TP as one character: a macro runs on (§6.3)
-    got, end = b"", time.monotonic() + 2
+    got, end = b"", time.monotonic() + ROOM_S
     while not got.endswith(END) and time.monotonic() < end:
         got += port.read(port.in_waiting or 1)
     assert got.startswith(b"P:") and got.endswith(END), got
@@ -78,7 +78,7 @@ def start(port) -> None:
 def test_an_output_of_one_controller_moves_the_other(tmp_path):
     with PtyServer(chain.for_rig(the_rig(rig_at(tmp_path)))) as server, raw_port(server) as port:
         start(port)
-        assert eventually(server, lambda c: c.by_address(1).machine.position() >= 1000, 5)
+        assert eventually(server, lambda c: c.by_address(1).machine.position() >= 1000)
         x, y = position(port, 0), position(port, 1)
         assert x >= 1000 and y >= 500
         assert abs(x // 1000 - y // 500) <= 1  # lock-step: one row per line, never ahead
@@ -89,7 +89,7 @@ def test_without_the_wires_the_other_one_never_moves(tmp_path):
     path = rig_at(tmp_path, RIG.replace('wires = ["x.out1 -> y.in1", "y.out2 -> x.in2"]', ""))
     with PtyServer(chain.for_rig(the_rig(path))) as server, raw_port(server) as port:
         start(port)
-        assert eventually(server, lambda c: c.by_address(0).machine.outputs_pattern() == 1, 3)
+        assert eventually(server, lambda c: c.by_address(0).machine.outputs_pattern() == 1)
         time.sleep(0.1)
         assert position(port, 1) == 0 and position(port, 0) == 1000  # X waits for ever on in2
 
@@ -129,7 +129,7 @@ def test_the_raster_rig_flashed_and_started_scans_on_both_axes(tmp_path):
             # y is reset and runs its autostart (waits for a line, §6.4 RT); x, whose box is
             # not plugged in, is told what its autostart sets and starts its scan, macro 3
             port.write(select(1) + b"RT\r" + select(0) + b"SV20000,SA200000\rEM3\r")
-            end, rows = time.monotonic() + 8, 0
+            end, rows = time.monotonic() + ROOM_S, 0
             while rows < 1000 and time.monotonic() < end:
                 time.sleep(0.2)
                 rows = position(port, 1)  # Y stepped a row per line of X

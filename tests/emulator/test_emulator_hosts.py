@@ -18,7 +18,8 @@ from mercmac.compiler.program import Op
 from mercmac.emulator.virtual import Faults
 from mercmac.upload import protocol
 from mercmac.vm import Machine, Options, reports
-from helpers.emulator import basil_mercury, eventually, raw_port, read_for, serve
+from helpers.emulator import (FAST, ROOM_S, HeldClock, basil_mercury, drain, eventually, raw_port, read_for,
+                              serve, typed, until)
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs pseudo-terminals")
 
@@ -28,7 +29,7 @@ OLD_VE = "(c)2003 Physik Instrumente(PI) Karlsruhe, C-862, Ver. 1.20, 2003-05-10
 PROGRAM = "target C-863\n[MC05] MR5000,WS100\n"
 
 
-def replies(port, n: int, seconds: float = 2.0) -> list[bytes]:
+def replies(port, n: int, seconds: float = ROOM_S) -> list[bytes]:
     """The next n reports as they came, each with its CR LF ETX (fewer if they do not come)."""
     data, end = b"", time.monotonic() + seconds
     while data.count(b"\x03") < n and time.monotonic() < end:
@@ -97,8 +98,8 @@ def test_an_etx_after_each_cr_is_ignored():
                                                               b"T:+0000000000" + END]
         assert status(port, b"TS\r\x03").error == 0
         port.write(b"EM3\r\x03")  # the ETX must not stop the macro it just started
-        time.sleep(0.1)
-        assert server.call(lambda v: v.machine.macro) == 3
+        assert until(server.served)  # both read
+        assert eventually(server, lambda v: v.machine.macro == 3)
 
 
 # -- TS: "macro running" and the error code -------------------------------------------------
@@ -159,7 +160,7 @@ def test_a_hit_limit_switch_drives_its_line_to_its_active_level(model, block, ne
 def test_an_unknown_model_goes_on_as_the_files_target(tmp_path, program_file):
     with serve(faults=Faults(version=OLD_VE)) as (server, vc):
         result = cli("flash", server.path, program_file, "--backup", tmp_path / "b.mcm",
-                     "--timeout", "0.3")
+                     *FAST)
     assert result.exit_code == 0, result.output
     assert "C-862" in result.output and "going on as the C-863" in result.output
     assert vc.macros == {5: "MR5000,WS100"}
@@ -170,7 +171,7 @@ def test_an_unknown_model_goes_on_as_the_target_option(tmp_path):
     prog.write_text("[MC05] MR5000,WS100\n")
     with serve(faults=Faults(version=OLD_VE)) as (server, vc):
         result = cli("flash", server.path, prog, "--target", "C-663", "--backup",
-                     tmp_path / "b.mcm", "--timeout", "0.3")
+                     tmp_path / "b.mcm", *FAST)
     assert result.exit_code == 0, result.output
     assert "going on as the C-663" in result.output and vc.macros == {5: "MR5000,WS100"}
 
@@ -180,7 +181,7 @@ def test_an_unknown_model_without_any_target_is_refused_saying_what_ve_answered(
     prog.write_text("[MC05] MR5000,WS100\n")
     with serve(faults=Faults(version=OLD_VE)) as (server, vc):
         result = cli("flash", server.path, prog, "--backup", tmp_path / "b.mcm",
-                     "--timeout", "0.3")
+                     *FAST)
         assert result.exit_code == 1, result.output
         assert "C-862, Ver. 1.20" in result.output and "--target" in result.output
         assert "nothing was written" in result.output and vc.md_count == 0
@@ -188,7 +189,7 @@ def test_an_unknown_model_without_any_target_is_refused_saying_what_ve_answered(
 
 def test_pull_reads_a_controller_of_an_unknown_model(tmp_path):
     with serve(faults=Faults(version=OLD_VE), macros={5: "GH"}) as (server, vc):
-        result = cli("pull", server.path, "--timeout", "0.3")
+        result = cli("pull", server.path, *FAST)
     assert result.exit_code == 0, result.output
     assert "[MC05] GH" in result.output and "\ntarget " not in result.output
 
@@ -213,26 +214,29 @@ def test_paced_bytes_arrive_at_the_baud_rate():
 
 
 def test_paced_link_drops_a_line_typed_slower_than_20ms_whatever_the_firmware():
-    with serve(faults=Faults(pace=True), firmware="2.30") as (server, vc), raw_port(server) as port:
+    clock = HeldClock()  # the gaps on the emulator's clock, whatever the load
+    with serve(clock, faults=Faults(pace=True), firmware="2.30") as (server, vc), \
+            raw_port(server) as port:
         port.write(SELECT)
-        for ch in b"TB\r":
-            port.write(bytes([ch]))
-            time.sleep(0.03)
+        typed(server, port, b"TB\r", clock, 0.03)
+        clock.release()  # real time from here: an answer, if any, would be paced out
         assert read_for(port) == b""
         assert status(port).error == 0x01  # §6.4 TS: 01 RS-232 timeout
 
 
 def test_paced_link_loses_characters_typed_at_full_speed_during_a_move():
-    with serve(faults=Faults(pace=True)) as (server, vc), raw_port(server) as port:
-        port.write(SELECT + b"MR200000\r")  # about 4.5 s at the C-863's SV 45000
-        time.sleep(0.05)
-        port.write(b"TT\r")
+    clock = HeldClock()
+    with serve(clock, faults=Faults(pace=True)) as (server, vc), raw_port(server) as port:
+        typed(server, port, SELECT + b"MR200000\r", clock, 0)  # about 4.5 s at SV 45000
+        clock.advance(0.05)
+        typed(server, port, b"TT\r", clock, 0)  # at full speed: at one instant
+        clock.advance(0.05)  # time for an answer to be paced out, if there were one
         assert read_for(port) == b""  # 'T' taken, the next one lost: "T" + CR, error 06
         assert server.call(lambda v: v.lost) >= 1
-        assert ask(port, b"'")[0].startswith(b"P:")  # one character alone gets through
-        for ch in b"TT\r":  # 5 ms apart: slower than the receiver, faster than 20 ms
-            port.write(bytes([ch]))
-            time.sleep(0.005)
+        typed(server, port, b"'", clock, 0.05)
+        assert replies(port, 1)[0].startswith(b"P:")  # one character alone gets through
+        typed(server, port, b"TT\r", clock, 0.005)  # slower than the receiver, faster than 20 ms
+        clock.advance(0.05)
         assert replies(port, 1) == [b"T:+0000200000" + END]
 
 
@@ -288,11 +292,10 @@ def test_emulate_refuses_a_log_that_is_not_a_regular_file(tmp_path, kind):
 @pytest.mark.parametrize("write_termination", ["", "\x03"])  # "\x03": basil's default, an ETX
 def test_basil_daq_mercury_driver(write_termination):
     with serve() as (server, vc):
-        with basil_mercury(server.path, write_termination) as dut:
+        with basil_mercury(server, write_termination) as dut:
             mercury = dut["Mercury"]
             assert 0 in mercury._board_numbers
-            time.sleep(0.05)
-            dut["Serial"]._port.reset_input_buffer()  # the second TB's answer it never reads
+            drain(dut["Serial"]._port)  # the second TB's answer, if basil has not read it
             assert mercury.get_board_number(0) == "B:0\r\n\x03"
             assert mercury.get_position(0) == 0
             mercury.motor_on(0)

@@ -2,13 +2,12 @@
 from __future__ import annotations
 
 import os
-import time
 
 import pytest
 
 from mercmac.upload import protocol
 from mercmac.emulator.virtual import Faults
-from helpers.emulator import raw_port, read_for, serve
+from helpers.emulator import HeldClock, eventually, raw_port, read_for, serve, typed
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs pseudo-terminals")
 
@@ -45,22 +44,20 @@ def test_md_is_silent_and_overwrites():
 
 
 def test_firmware_1_drops_a_line_typed_slower_than_20ms_per_character():
-    with serve(firmware="1.06", macros={2: "GH"}) as (server, vc), raw_port(server) as port:
+    clock = HeldClock()  # 30 ms between the bytes on the emulator's clock, whatever the load
+    with serve(clock, firmware="1.06", macros={2: "GH"}) as (server, vc), raw_port(server) as port:
         port.write(b"\x010")
-        for ch in b"TM2\r":
-            port.write(bytes([ch]))
-            time.sleep(0.03)
+        typed(server, port, b"TM2\r", clock, 0.03)
         assert read_for(port) == b""
         port.write(b"TM2\r")  # in one write, as the uploader sends lines
         assert read_for(port) == b"MC002 GH\r\n\x03"
 
 
 def test_firmware_2_accepts_slow_typing():
-    with serve(firmware="2.30", macros={2: "GH"}) as (server, vc), raw_port(server) as port:
+    clock = HeldClock()
+    with serve(clock, firmware="2.30", macros={2: "GH"}) as (server, vc), raw_port(server) as port:
         port.write(b"\x010")
-        for ch in b"TM2\r":
-            port.write(bytes([ch]))
-            time.sleep(0.03)
+        typed(server, port, b"TM2\r", clock, 0.03)
         assert read_for(port) == b"MC002 GH\r\n\x03"
 
 
@@ -98,9 +95,8 @@ def test_a_running_macro_reports_and_any_character_stops_it_but_percent_does_not
         port.write(b"%")
         assert b"S:" in read_for(port, 0.1) and vc.running
         port.write(b"x")  # MS176E §3.8.3: "just send a character, e.g. x"
-        time.sleep(0.05)
-        port.reset_input_buffer()
-        assert not vc.running
+        assert eventually(server, lambda v: not v.running)
+        read_for(port, 0)  # the reports it made before it stopped
         assert read_for(port, 0.1) == b""
 
 

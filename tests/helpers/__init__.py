@@ -5,7 +5,8 @@
     cli          run `mercmac` in-process (click) or as a process; its exit codes; a hang guard
     files        what a whole-or-nothing write leaves behind
     simulation   a simulation run as plain data, to compare two runs
-    emulator     the virtual controller on a pty, and the short timeouts to talk to it
+    emulator     the virtual controller on a pty, timeouts with room, clocks a test controls
+    locking      a lock between processes (pytest-xdist workers)
     lsp_wire     a real `mercmac lsp` fed raw bytes
     semantics    a model of the firmware and of the structured program, to compare traces
     programs     random well-formed programs (Hypothesis strategies)

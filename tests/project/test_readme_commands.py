@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from helpers.cli import cli
+from helpers.emulator import line_clock
 from helpers.paths import EXAMPLE4
 from helpers.readme import HARDWARE_PORTS, README, commands, prepare, promise, tour_program
 
@@ -27,7 +28,9 @@ def port():
     from mercmac.emulator.ptyserver import PtyServer
     from mercmac.emulator.virtual import VirtualController
 
-    with PtyServer(VirtualController("C-863", 0)) as server:
+    # the commands' default timeouts on the line's clock: an answer is awaited however
+    # loaded the machine, and the silent addresses of `scan` pass in milliseconds
+    with PtyServer(VirtualController("C-863", 0)) as server, line_clock(server):
         yield server.path
 
 

@@ -23,3 +23,20 @@ def test_a_ctrl_c_test_passes_when_the_suite_inherits_sigint_ignored():
                          cwd=ROOT, capture_output=True, text=True, timeout=120,
                          preexec_fn=_ignoring_sigint)
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-2000:]
+
+
+def _ignoring_sighup() -> None:
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not hasattr(signal, "SIGHUP"), reason="needs POSIX signals")
+def test_a_hang_up_test_passes_when_the_suite_runs_under_nohup():
+    """`nohup pytest` (SIGHUP ignored, inherited by every child): a mercmac a test hangs up
+    still stops as a user's would (issue 26: it flashed on and exited 0)."""
+    test = ("tests/upload/test_flash_signals.py::"
+            "test_a_signal_while_a_file_is_flashed_says_what_the_controller_holds[SIGHUP]")
+    run = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", test],
+                         cwd=ROOT, capture_output=True, text=True, timeout=120,
+                         preexec_fn=_ignoring_sighup)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-2000:]

@@ -15,17 +15,20 @@ import subprocess
 import sys
 import zipfile
 from pathlib import Path
+from typing import Iterator
 
 import pytest
 
+from helpers.locking import held, lock_file
 from helpers.paths import ROOT
 from mercmac.highlight import textmate_json
 
 VSCODE = ROOT / "editors" / "vscode"
 GRAMMAR = VSCODE / "syntaxes" / "mcm.tmLanguage.json"
 STAMP = VSCODE / "node_modules" / ".mercmac-lock-sha256"
-# One worker runs them all (pytest-xdist): the node tests share node_modules/ and dist/.
-pytestmark = pytest.mark.xdist_group("vscode")
+# The node tests share node_modules/ and dist/ (`vsce package` rebuilds dist/ too): each
+# holds a lock on them from the install to its end, so that two pytest-xdist workers take
+# turns (scheduling them on one worker, `xdist_group`, does nothing under pytest 9).
 # What the .vsix holds (vsce's own files aside): the bundle, never the sources or the tests.
 PACKAGED = {"extension/package.json", "extension/readme.md", "extension/LICENSE.txt",
             "extension/icon.png", "extension/dist/extension.js",
@@ -54,13 +57,20 @@ def _npm(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
                           text=True, timeout=timeout, stdin=subprocess.DEVNULL)
 
 
-@pytest.fixture(scope="module")
-def node_packages() -> str:
+@pytest.fixture
+def node_packages() -> Iterator[str]:
     """node, with the extension's packages installed (once, while the lock file is the same)
-    and its bundle built; the test is skipped when Node.js or npm is missing."""
+    and its bundle built, for this test alone among the workers; the test is skipped when
+    Node.js or npm is missing."""
     node, npm = shutil.which("node"), shutil.which("npm")
     if node is None or npm is None:
         pytest.skip("Node.js (node and npm) is not installed: the VS Code extension is not tested")
+    with held(lock_file(VSCODE)):
+        yield _installed(node)
+
+
+def _installed(node: str) -> str:
+    """node, after `npm ci` (unless the stamp says the lock file is installed) and the build."""
     lock = hashlib.sha256((VSCODE / "package-lock.json").read_bytes()).hexdigest()
     if not STAMP.exists() or STAMP.read_text() != lock:
         done = _npm("ci", "--no-audit", "--no-fund")

@@ -27,7 +27,7 @@ from markdown_it import MarkdownIt
 from markdown_it.tree import SyntaxTreeNode
 
 from helpers.cli import cli
-from helpers.emulator import FAST, FAST_TIMING, serve
+from helpers.emulator import FAST, FAST_TIMING, line_clock, serve
 from helpers.paths import EXAMPLE4, ROOT
 from helpers.rig_files import X, Y
 from mercmac import names
@@ -91,7 +91,7 @@ def _output(*args) -> str:
 @contextmanager
 def _chain(macros=({}, {})):
     vcs = [VirtualController("C-663", a, macros=dict(m)) for a, m in enumerate(macros)]
-    with PtyServer(Chain(vcs)) as server:
+    with PtyServer(Chain(vcs)) as server, line_clock(server):  # addresses of nobody: fast
         yield server
 
 

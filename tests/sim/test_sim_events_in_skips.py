@@ -57,6 +57,7 @@ def test_skipped_passes_list_the_events_stepping_lists(name):
     assert stepped(fast["events"]) == plain["events"]
 
 
+@pytest.mark.slow  # two runs of 3 000 000 ms each, one of them stepped: a minute under load
 @pytest.mark.parametrize("name", LOOPS)
 def test_past_the_cap_the_events_of_skipped_passes_are_counted(name):
     program = program_of(LOOPS[name])

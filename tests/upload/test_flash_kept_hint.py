@@ -3,7 +3,7 @@ against the emulator on a real pseudo-terminal, through the real CLI."""
 from __future__ import annotations
 
 from helpers.cli import cli
-from helpers.emulator import serve
+from helpers.emulator import FAST, serve
 
 PROGRAM = "target C-863\n[MC03] MR100\n[MC04] TP\n"
 
@@ -11,7 +11,7 @@ PROGRAM = "target C-863\n[MC03] MR100\n[MC04] TP\n"
 def flash(server, tmp_path, *options):
     prog = tmp_path / "p.mcm"
     prog.write_text(PROGRAM, encoding="utf-8")
-    return cli("flash", server.path, prog, "--backup", tmp_path / "b.mcm", "--timeout", "0.3",
+    return cli("flash", server.path, prog, "--backup", tmp_path / "b.mcm", *FAST,
                *options)
 
 

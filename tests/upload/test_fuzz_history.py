@@ -25,7 +25,7 @@ from hypothesis import strategies as st
 from mercmac.cli import main
 from helpers.budgets import fuzz_budget
 from helpers.cli import KNOWN_EXITS, hang_guard
-from helpers.emulator import FAST, serve
+from helpers.emulator import FAST, serve_clocked
 from test_hostile_history import PROGRAM
 
 pytestmark = pytest.mark.skipif(not (hasattr(os, "openpty") and hasattr(os, "mkfifo")),
@@ -145,7 +145,7 @@ def flashed(tmp_path_factory):
     """(emulator holding PROGRAM, the record its flash wrote) for the whole module."""
     home = tmp_path_factory.mktemp("flashed")
     (home / "prog.mcm").write_text(PROGRAM)
-    with serve() as (server, vc):
+    with serve_clocked() as (server, vc):  # the silences of pull and decompile: fast
         done = _run(["flash", server.path, str(home / "prog.mcm"), "--backup",
                      str(home / "b.mcm"), *FAST], home / "data")
         assert done.exit_code == 0, done.output

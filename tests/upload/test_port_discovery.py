@@ -10,6 +10,7 @@ from __future__ import annotations
 import io
 import re
 import time
+from contextlib import contextmanager
 from types import SimpleNamespace
 
 import pytest
@@ -17,10 +18,20 @@ import pytest
 from helpers.cli import cli
 from mercmac.upload import survey
 from mercmac.upload.survey import PortInfo
-from helpers.emulator import serve
+from helpers import emulator
+from helpers.emulator import FAST
 
 PROGRAM = "target C-863\n[MC00] EM5\n[MC05] MR5000,WS100\n"
-SEARCH_TIMEOUT = ["--timeout", "0.1"]  # the search of addresses 1-15 waits this long at each
+# the search of addresses 1-15 waits this long at each, on the line's clock (serve, below)
+SEARCH_TIMEOUT = list(FAST)
+
+
+@contextmanager
+def serve(**kw):
+    """helpers.emulator.serve on its line's clock: the silent addresses of a search or a
+    scan pass in milliseconds, and an answer however late is never taken for silence."""
+    with emulator.serve(**kw) as (server, vc), emulator.line_clock(server):
+        yield server, vc
 
 
 @pytest.fixture(autouse=True)
@@ -66,15 +77,13 @@ def test_pull_finds_the_only_controller_without_address(tmp_path):
     assert "address 7" in result.output
 
 
-def test_address_0_is_used_at_once_without_a_search(program_file, tmp_path):
+def test_address_0_is_used_at_once_without_a_search(program_file, tmp_path, monkeypatch):
+    waits = emulator.timeouts(monkeypatch)
     with serve() as (server, vc):
-        started = time.monotonic()
-        result = cli("flash", server.path, program_file, "--backup", tmp_path / "b.mcm",
-                     "--timeout", "1")
-        took = time.monotonic() - started
+        result = cli("flash", server.path, program_file, "--backup", tmp_path / "b.mcm", *FAST)
     assert result.exit_code == 0, result.output
     assert "only one that answers" not in result.output
-    assert took < 4  # a search of 1-15 would wait 15 x 0.3 s
+    assert waits == []  # a search of 1-15 would wait at each of them
 
 
 def test_an_explicit_address_is_not_searched(program_file):
@@ -134,7 +143,7 @@ def test_port_option(tmp_path, program_file):
     with serve(macros={2: "TP"}) as (server, vc):
         flashed = cli("flash", "-p", server.path, program_file, "--backup", tmp_path / "b.mcm", *SEARCH_TIMEOUT)
         pulled = cli("pull", "--port", server.path, *SEARCH_TIMEOUT)
-        scanned = cli("scan", "-p", server.path, "--timeout", "0.05")
+        scanned = cli("scan", "-p", server.path, *FAST)
     assert flashed.exit_code == 0, flashed.output
     assert pulled.exit_code == 0 and "[MC05] MR5000,WS100" in pulled.output
     assert scanned.exit_code == 0 and "C-863" in scanned.output
@@ -185,7 +194,7 @@ def test_scan_shows_each_address_on_a_terminal(monkeypatch):
     monkeypatch.setenv("FORCE_COLOR", "1")
     monkeypatch.delenv("NO_COLOR", raising=False)
     with serve(address=11) as (server, vc):
-        result = cli("scan", server.path, "--timeout", "0.05")
+        result = cli("scan", server.path, *FAST)
     assert result.exit_code == 0
     assert "scanning: address 0 of 0-15" in result.stderr
     assert "scanning: address 15 of 0-15" in result.stderr
@@ -194,7 +203,7 @@ def test_scan_shows_each_address_on_a_terminal(monkeypatch):
 def test_scan_shows_no_progress_in_a_log(monkeypatch):
     monkeypatch.delenv("FORCE_COLOR", raising=False)
     with serve(address=11) as (server, vc):
-        result = cli("scan", server.path, "--timeout", "0.05")
+        result = cli("scan", server.path, *FAST)
     assert "scanning" not in result.output
 
 

@@ -8,7 +8,7 @@ from contextlib import contextmanager
 
 from mercmac.upload import survey
 from mercmac.upload.flasher import FlashOptions, Watch, flash_file
-from helpers.emulator import FAST_TIMING, serve
+from helpers.emulator import FAST_TIMING, serve_clocked as serve  # searches: on the line's clock
 
 
 class Searches:

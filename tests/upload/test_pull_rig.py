@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from helpers.cli import cli, mercmac_process
-from helpers.emulator import FAST, FAST_TIMING
+from helpers.emulator import FAST, FAST_TIMING, line_clock
 from helpers.paths import ROOT
 from mercmac.compiler import compile_file
 from mercmac.emulator.chain import Chain
@@ -26,7 +26,7 @@ RAW = ({1: "CN1,WN2,CF1,WF2", 0: "SV20000,CP0,EM1"}, {0: "SV10000,WN1,MR500,WS10
 @contextmanager
 def chain(macros=({}, {})):
     vcs = [VirtualController("C-663", a, macros=dict(m)) for a, m in enumerate(macros)]
-    with PtyServer(Chain(vcs)) as server:
+    with PtyServer(Chain(vcs)) as server, line_clock(server):  # addresses of nobody: fast
         yield server, vcs
 
 

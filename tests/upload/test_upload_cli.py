@@ -14,7 +14,7 @@ from mercmac.compiler import compile_source
 from mercmac.source import Source
 from mercmac.emulator.virtual import Faults
 from mercmac.upload.survey import PortInfo
-from helpers.emulator import FAST, serve
+from helpers.emulator import FAST, line_clock, serve
 from helpers.paths import EXAMPLE4
 
 PROGRAM = "target C-863\n[MC00] EM5\n[MC05] MR5000,WS100\n"
@@ -121,23 +121,25 @@ def test_pull_to_standard_output(tmp_path):
 
 
 def test_scan_lists_who_answers(tmp_path):
-    with serve(address=11, macros={2: "TP"}) as (server, vc):
-        result = cli("scan", server.path, "--timeout", "0.05")
+    # 15 silent addresses, each waited out on the line's clock: fast, and 11's answer,
+    # however late a loaded machine makes it, is never taken for silence
+    with serve(address=11, macros={2: "TP"}) as (server, vc), line_clock(server):
+        result = cli("scan", server.path, *FAST)
     assert result.exit_code == 0, result.output
     row = [line for line in result.output.splitlines() if line.startswith("11 ")]
     assert row and "C-863" in row[0] and "2.30" in row[0]
 
 
 def test_scan_leaves_a_running_macro_alone(tmp_path):
-    with serve(address=4, macros={0: "SC4,WA10,RP"}) as (server, vc):
-        result = cli("scan", server.path, "--timeout", "0.05")
+    with serve(address=4, macros={0: "SC4,WA10,RP"}) as (server, vc), line_clock(server):
+        result = cli("scan", server.path, *FAST)
         assert server.call(lambda v: v.running)
     assert "macro running, left alone" in result.output
 
 
 def test_scan_of_silence_exits_1():
-    with serve(faults=Faults(silent=True)) as (server, vc):
-        result = cli("scan", server.path, "--timeout", "0.05")
+    with serve(faults=Faults(silent=True)) as (server, vc), line_clock(server):
+        result = cli("scan", server.path, *FAST)
     assert result.exit_code == 1 and "no controller answered" in result.output
 
 
