@@ -297,7 +297,7 @@ def _refuse_rig_build(path: str) -> None:
     import shlex
 
     from mercmac.cli.common import UsageError
-    from mercmac.render.report import printable
+    from mercmac.names import printable
     from mercmac.rig.load import read_rig
 
     try:

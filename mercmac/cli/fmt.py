@@ -81,9 +81,8 @@ def _one(path: str, *, check: bool, diff: bool) -> bool | None:
     """
     from mercmac import outfile
     from mercmac.fmt import FormatError, format_text, load
+    from mercmac.names import printable
     from mercmac.source import read_bytes
-
-    from mercmac.render.report import printable
 
     name = "<stdin>" if path == "-" else printable(path)
     try:
