@@ -84,9 +84,9 @@ def test_mercmac_fuzz_examples_still_sets_a_fuzz_budget(monkeypatch):
 @pytest.mark.slow
 def test_an_unknown_profile_stops_pytest_naming_the_choices():
     env = {**os.environ, budgets.VARIABLE: "fast"}
-    run = subprocess.run([sys.executable, "-m", "pytest", "-n", "0", "-p", "no:cacheprovider", "--collect-only",
-                          "tests/project/test_readme.py"], cwd=ROOT, env=env, capture_output=True,
-                         text=True, timeout=120)
+    run = subprocess.run([sys.executable, "-m", "pytest", "-n", "0", "-p", "no:cacheprovider",
+                          "--collect-only", "tests/project/test_readme.py"], cwd=ROOT, env=env,
+                         capture_output=True, text=True, timeout=120)
     assert run.returncode == 4, run.stdout[-2000:] + run.stderr[-2000:]  # pytest: usage error
     assert f"{budgets.VARIABLE}='fast'" in run.stderr and "dev, ci, thorough" in run.stderr
     assert "Traceback" not in run.stderr
