@@ -45,7 +45,9 @@ _PORT_OPTION = click.option("-p", "--port", "port_option", metavar="PORT", multi
 _BAUD = click.option("--baud", type=click.IntRange(300, 921_600), default=9600, show_default=True,
                      help="Baud rate, DIP switches 5-6.")
 _TIMEOUT = click.option("--timeout", type=FiniteFloat(0.05, 60), default=1.0,
-                        show_default=True, help="Seconds to wait for each reply.")
+                        show_default=True,
+                        help="Seconds to wait for each reply; given, also the wait at each "
+                             "address when looking for controllers (default 0.3 there).")
 
 
 def looks_like_program(text: str) -> bool:
@@ -98,9 +100,14 @@ def _port(port: str | None, option: str | None, command: str) -> str:
 
 
 def _timing(timeout: float):
+    """The Timing of this command's --timeout; given on the command line (not defaulted),
+    it is also the wait at each address of a search (pull --rig, flash without --address)."""
     from mercmac.upload.transport import Timing
 
-    return Timing.waiting(timeout)
+    context = click.get_current_context(silent=True)
+    given = context is not None and context.get_parameter_source("timeout") in (
+        click.core.ParameterSource.COMMANDLINE, click.core.ParameterSource.ENVIRONMENT)
+    return Timing.waiting(timeout, searching_too=given)
 
 
 @click.command()

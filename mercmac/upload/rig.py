@@ -348,13 +348,14 @@ def pull_rig(port: str, *, baud: int = DEFAULT_BAUD, timing: Timing = Timing(),
     Refused when none answers, or two answer at one address (survey.Found.shared)."""
     with open_controller(port, 0, baud=baud, timing=timing) as first:
         t = first.transport
-        t.timing = replace(timing, timeout=min(timing.timeout, survey.SEARCH_TIMEOUT))
+        t.timing = timing.searching
         found = [f for f in survey.scan(t, stop=True, on_address=on_address) if f.status]
         t.timing = timing
         if not found:
             raise Refused(f"no controller answers at addresses 0-15 on {port}",
                           hint=f"check power and cable, and that DIP switches 5-6 set the "
-                               f"baud rate {baud}")
+                               f"baud rate {baud}; each address was given {timing.search:g} s "
+                               f"(--timeout gives more)")
         _one_at_each(found, port)
         read = [(f.address, survey.pull(Controller(t, f.address))) for f in found]
     return _named(read, port, records or [])

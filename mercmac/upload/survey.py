@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from contextlib import AbstractContextManager, nullcontext
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Callable
 
 from mercmac.upload import backup
@@ -15,7 +15,6 @@ from mercmac.upload.transport import DEFAULT_BAUD, Timing, Transport
 
 PI_VENDOR = 0x1A72  # USB vendor id of Physik Instrumente
 PI_PRODUCTS = {0x1007: "C-863"}  # USB product ids known to be Mercury controllers
-SEARCH_TIMEOUT = 0.3  # s: the longest wait at each address when looking for the controller
 
 # Around a search for the controller's address: yields where each address probed is told.
 Searching = Callable[[], AbstractContextManager[Callable[[int], None]]]
@@ -131,7 +130,8 @@ def find_address(transport: Transport,
     """The address to use when none was given: 0 if anything answers there (the default
     of old, and no search), else the only one of 1-15 that answers `%`.
 
-    Addresses 1-15 are probed with at most SEARCH_TIMEOUT each (about 5 s in all).
+    Addresses 1-15 are probed with the transport's search timing (Timing.search each: with
+    the default 0.3 s, about 5 s in all).
     Refused when none answers; NotChosen (exit 2) when several do: say which with --address.
     """
     at_zero = Controller(transport, 0)
@@ -146,7 +146,7 @@ def find_address(transport: Transport,
     except ControllerError:
         return 0  # an answer at 0, even a garbled one: 0, as without the search (identify says why)
     timing = transport.timing
-    transport.timing = replace(timing, timeout=min(timing.timeout, SEARCH_TIMEOUT))
+    transport.timing = timing.searching
     try:
         found = scan(transport, range(1, 16), on_address=on_address)
     except UploadError as e:
@@ -171,7 +171,8 @@ def find_address(transport: Transport,
                            f"DIP switches 5-6 against --baud {transport.baud}")
     raise Refused(f"nothing answers at addresses 0-15 {where}; nothing was written",
                   hint=f"check power and cable, and that DIP switches 5-6 set the baud rate "
-                       f"{transport.baud}")
+                       f"{transport.baud}; each address was given {timing.search:g} s "
+                       f"(--timeout gives more)")
 
 
 def answered(found: list[Found]) -> bool:

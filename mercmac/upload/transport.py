@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 from mercmac.upload.protocol import ProtocolError, ReportSplitter
@@ -16,6 +16,7 @@ from mercmac.upload.protocol import ProtocolError, ReportSplitter
 DEFAULT_BAUD = 9600  # MS176E §3.3: MMCRun's rate, DIP switches 5 and 6 ON
 POLL_S = 0.02  # how long one pyserial read may block; bounds the reaction to Ctrl-C
 LONGEST_REPLY = 4096  # bytes: a TM listing of 31 full macros stays under this
+SEARCH_TIMEOUT = 0.3  # s: the wait at each address when looking for controllers, unless told
 
 
 class TransportError(Exception):
@@ -41,22 +42,32 @@ class ReadTimeout(TransportError):
 
 @dataclass(frozen=True, slots=True)
 class Timing:
-    """Read timeouts in seconds: per report, and the quiet time that ends a listing."""
+    """Read timeouts in seconds: per report, the quiet time that ends a listing, and the
+    wait at each address of a search (16 addresses, so short unless the user says)."""
 
     timeout: float = 1.0  # silence after which a reply is given up (flash writes take a while)
     settle: float = 0.25  # quiet time after an ETX that ends a multi-report TM listing
+    search: float = SEARCH_TIMEOUT  # silence after which an address is taken for empty
 
     def __post_init__(self) -> None:
         # nan compares false with everything: a nan timeout would never expire
-        for name in ("timeout", "settle"):
+        for name in ("timeout", "settle", "search"):
             if not 0 < getattr(self, name) < math.inf:
                 raise ValueError(f"{name} must be a positive number of seconds, "
                                  f"not {getattr(self, name)!r}")
 
     @classmethod
-    def waiting(cls, timeout: float) -> "Timing":
-        """The timing for a `--timeout` option: a listing settles within the reply timeout."""
-        return cls(timeout=timeout, settle=min(0.25, timeout))
+    def waiting(cls, timeout: float, *, searching_too: bool = False) -> "Timing":
+        """The timing for a `--timeout` option: a listing settles within the reply timeout,
+        and a search waits as long at each address when the user gave the timeout
+        (`searching_too`: a slow link is slow at every address), else SEARCH_TIMEOUT at most."""
+        search = timeout if searching_too else min(timeout, SEARCH_TIMEOUT)
+        return cls(timeout=timeout, settle=min(0.25, timeout), search=search)
+
+    @property
+    def searching(self) -> "Timing":
+        """This timing while looking for controllers: each reply waited for `search` s."""
+        return replace(self, timeout=self.search)
 
     def budget(self, baud: int, size: int = LONGEST_REPLY) -> float:
         """Longest time one exchange may take: a timeout plus `size` bytes at `baud`."""

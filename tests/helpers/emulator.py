@@ -21,6 +21,10 @@ from mercmac.upload.transport import Timing
 # time stays short: a TM listing comes in one write of the emulator.
 FAST_TIMING = Timing(timeout=5.0, settle=0.05)
 FAST = ("--timeout", str(FAST_TIMING.timeout))
+# For a mercmac process that looks for controllers (pull --rig, flash without --address): a
+# given --timeout is also the wait at each of the 16 addresses, most of them empty, and a
+# process cannot run on a LineClock: 1.5 s, five times the default search wait.
+SEARCHING = ("--timeout", "1.5")
 ROOM_S = 20.0  # how long an event that comes at once on a quiet machine may take under load
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from helpers.cli import cli, mercmac_process
-from helpers.emulator import FAST, FAST_TIMING, emulating, eventually
+from helpers.emulator import FAST, FAST_TIMING, SEARCHING, emulating, eventually
 from helpers.paths import ROOT
 from mercmac.emulator.chain import Chain
 from mercmac.emulator.ptyserver import PtyServer
@@ -234,7 +234,7 @@ def test_flash_then_pull_against_emulate_addresses_as_processes(rig, tmp_path, d
     log, out = tmp_path / "wire.log", tmp_path / "pulled"
     with emulating("--addresses", "0,1", "--target", "C-663", "--log", str(log)) as (_, path):
         flashed = mercmac_process("flash", path, str(rig), *FAST, cwd=tmp_path)
-        pulled = mercmac_process("pull", path, "--rig", str(out), *FAST, cwd=tmp_path)
+        pulled = mercmac_process("pull", path, "--rig", str(out), *SEARCHING, cwd=tmp_path)
     assert flashed.returncode == 0, flashed.stderr
     assert pulled.returncode == 0, pulled.stderr
     lines = written(log.read_text())

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from helpers.cli import cli, mercmac_process
-from helpers.emulator import FAST, FAST_TIMING, line_clock
+from helpers.emulator import FAST, FAST_TIMING, SEARCHING, line_clock
 from helpers.paths import ROOT
 from mercmac.compiler import compile_file
 from mercmac.emulator.chain import Chain
@@ -95,7 +95,7 @@ def test_pull_rig_as_a_process(rig, tmp_path, data_dir):
     out = tmp_path / "pulled"
     with chain() as (server, vcs):
         flash_rig(server.path, str(rig), timing=FAST_TIMING)
-        done = mercmac_process("pull", server.path, "--rig", str(out), *FAST, cwd=tmp_path)
+        done = mercmac_process("pull", server.path, "--rig", str(out), *SEARCHING, cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert "recorded source" in done.stderr
     assert (out / "y.mcm").read_text() == (rig.parent / "y.mcm").read_text()
@@ -264,3 +264,31 @@ def test_a_history_name_like_another_address_does_not_merge_two_controllers(tmp_
     assert sorted(p.name for p in out.iterdir()) == ["a1.mcm", "a1_.mcm", "r.rig.toml"]
     assert (out / "a1.mcm").read_text() == X
     assert cli("check", out / "r.rig.toml").exit_code == 0
+
+
+# -- issue 26: a --timeout given is the wait at each address too ------------------------------
+
+@pytest.mark.parametrize("given, search", [((), 0.3), (("--timeout", "2"), 2.0),
+                                            (("--timeout", "0.1"), 0.1)])
+@pytest.mark.parametrize("command", [("pull", "--rig", "pulled"), ("flash", "prog.mcm")])
+def test_a_given_timeout_is_the_wait_at_each_address_searched(tmp_path, monkeypatch, given,
+                                                              search, command):
+    """`pull --rig` scanned, and `flash` without --address searched, at 0.3 s an address
+    whatever --timeout said: a slow link (an emulator on a loaded machine, a serial server
+    across a network) could not be given room. The default stays 0.3 s (16 addresses)."""
+    from mercmac.upload import survey
+
+    shutil.copy(ROOT / "examples" / "macros" / "jog-box.mcm", tmp_path / "prog.mcm")
+    scan, waits = survey.scan, []
+
+    def watched(transport, *args, **kw):
+        waits.append(transport.timing.timeout)
+        return scan(transport, *args, **kw)
+
+    monkeypatch.setattr(survey, "scan", watched)
+    monkeypatch.chdir(tmp_path)
+    # one controller, at 2: `flash` finds nobody at 0 and searches 1-15
+    with PtyServer(Chain([VirtualController("C-663", 2)])) as server, line_clock(server):
+        result = cli(command[0], server.path, *command[1:], *given)
+    assert result.exit_code == 0, result.output
+    assert waits == [search]
