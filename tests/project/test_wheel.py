@@ -125,8 +125,23 @@ def online_or_skip(done: subprocess.CompletedProcess, doing: str) -> None:
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
 
 
-# The tests of the released package share one build: on one worker (pytest-xdist loadgroup).
-RELEASE = pytest.mark.xdist_group("release")
+def shared(tmp_path_factory, name: str, make) -> Path:
+    """`make(folder)`'s folder, made once for the whole run: in the base temporary folder that
+    every pytest-xdist worker of this run shares (a worker's own is below it), under a lock,
+    as xdist's documentation shares session fixtures; the tests of it may run on any worker."""
+    from helpers.locking import held
+
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent
+    folder, made = root / name, root / f"{name}.made"
+    with held(root / f"{name}.lock"):
+        if not made.exists():
+            shutil.rmtree(folder, ignore_errors=True)  # what a failed attempt left
+            folder.mkdir()
+            make(folder)  # skips (offline) or fails before `made` is written
+            made.touch()
+    return folder
 
 
 @pytest.fixture(scope="module")
@@ -134,19 +149,20 @@ def released(tmp_path_factory) -> Path:
     """The sdist and the wheel, built by `python -m build` from a copy of the tree as a
     clone holds it (the wheel from the sdist, as build does: the sdist must hold enough)."""
     pytest.importorskip("build", reason="the extra `test` brings `build`")
-    work = tmp_path_factory.mktemp("release")
-    tree = work / "tree"
-    shutil.copytree(ROOT, tree, ignore=shutil.ignore_patterns(
-        ".git", ".venv", "node_modules", "__pycache__", "build", "dist", "*.egg-info",
-        ".hypothesis", ".pytest_cache", "*.vcd", "*.vsix"))
-    done = run([sys.executable, "-m", "build", "--outdir", str(work / "dist"), str(tree)],
-               env=outside_env(), cwd=work)
-    online_or_skip(done, "`python -m build` (setuptools in an isolated environment)")
-    return work / "dist"
+
+    def build(work: Path) -> None:
+        tree = work / "tree"
+        shutil.copytree(ROOT, tree, ignore=shutil.ignore_patterns(
+            ".git", ".venv", ".venvs", "node_modules", "__pycache__", "build", "dist",
+            "*.egg-info", ".hypothesis", ".pytest_cache", "*.vcd", "*.vsix"))
+        done = run([sys.executable, "-m", "build", "--outdir", str(work / "dist"), str(tree)],
+                   env=outside_env(), cwd=work)
+        online_or_skip(done, "`python -m build` (setuptools in an isolated environment)")
+
+    return shared(tmp_path_factory, "release", build) / "dist"
 
 
 @pytest.mark.slow
-@RELEASE
 def test_twine_checks_the_sdist_and_the_wheel(released):
     pytest.importorskip("twine", reason="the extra `test` brings `twine`")
     files = sorted(map(str, released.iterdir()))
@@ -156,7 +172,6 @@ def test_twine_checks_the_sdist_and_the_wheel(released):
 
 
 @pytest.mark.slow
-@RELEASE
 def test_the_wheel_holds_the_examples_and_the_sdist_the_tests(released):
     import tarfile
 
@@ -175,13 +190,14 @@ def test_the_wheel_holds_the_examples_and_the_sdist_the_tests(released):
 @pytest.fixture(scope="module")
 def installed(released, tmp_path_factory) -> Path:
     """A fresh venv with the wheel (and the extra `lsp`) installed from it: its bin/."""
-    venv = tmp_path_factory.mktemp("venv")
-    assert run([sys.executable, "-m", "venv", str(venv)], env=outside_env()).returncode == 0
-    (wheel,) = released.glob("*.whl")
-    done = run([str(venv / "bin" / "python"), "-m", "pip", "install", "-q", f"{wheel}[lsp]"],
-               env=outside_env(), cwd=venv)
-    online_or_skip(done, "installing the wheel's dependencies")
-    return venv / "bin"
+    def install(venv: Path) -> None:
+        assert run([sys.executable, "-m", "venv", str(venv)], env=outside_env()).returncode == 0
+        (wheel,) = released.glob("*.whl")
+        done = run([str(venv / "bin" / "python"), "-m", "pip", "install", "-q", f"{wheel}[lsp]"],
+                   env=outside_env(), cwd=venv)
+        online_or_skip(done, "installing the wheel's dependencies")
+
+    return shared(tmp_path_factory, "venv", install) / "bin"
 
 
 class Installed:
@@ -213,7 +229,6 @@ def first_setup_sim() -> str:
 
 
 @pytest.mark.slow
-@RELEASE
 def test_the_installed_wheel_runs_the_readme(installed, tmp_path):
     home = tmp_path / "empty"
     home.mkdir()
