@@ -1,4 +1,4 @@
-"""`mercmac check` on large files: wall time, peak memory, output size (issue 7, item 6).
+"""`mercmac check` on large files: wall time, peak memory, output size.
 
     python benchmarks/check_large.py [--size MB] [--timeout S]
 
@@ -7,12 +7,12 @@ Generated files, checked in a fresh interpreter (sizes for the default --size 1)
 (b) valid lines with many warnings (and a duplicate-slot error per line) (1 MB);
 (c) one 1 MB line with an unknown command every few bytes;
 (d) one line of 10,000 and (e) of 60,000 repeated `// ` after an error, ending in `mercmac`:
-    the suppression comment pattern was quadratic in it (issue 20: 9 s, past 60 s);
-(f) one macro of 100,000 commands on one 500 KB line (issue 20: 67-81 s);
+    the suppression comment pattern was quadratic in it (9 s, past 60 s);
+(f) one macro of 100,000 commands on one 500 KB line (67-81 s);
 (g) `when` blocks nested 32 deep, each followed by code: a block that calls on was
-    lowered twice per level (issue 20: 16 levels 0.9 s, doubling per level; 32 hours);
+    lowered twice per level (16 levels 0.9 s, doubling per level; 32 hours);
 (h) a line of 3,000 `repeat 1 { TP }` and (i) 3,000 lines of a block that calls on,
-    then code: one recursion per statement (issue 20: RecursionError, "internal error").
+    then code: one recursion per statement (RecursionError, "internal error").
 These three do not grow with --size.
 Checking must be linear in the file size. Goal: at most 2 s per MB, and under 2 s each.
 """

@@ -1,4 +1,4 @@
-"""Start-up latency of `mercmac check` (issue 2, Speed).
+"""Start-up latency of `mercmac check`.
 
 Prints the ratio of the median wall time of `mercmac check` on the manual's
 Example 4 to `python -c pass`, both run by the same interpreter, alternating

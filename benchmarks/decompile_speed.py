@@ -1,4 +1,4 @@
-"""Decompile speed on worst cases of 32 slots (issue 20, item 7): wall time per program.
+"""Decompile speed on worst cases of 32 slots: wall time per program.
 
     python benchmarks/decompile_speed.py [--cap SECONDS] [CASE-PREFIX...]
 

@@ -5,13 +5,12 @@
 Flashes FILE (default examples/macros/manual-example4-four-modes.mcm) to an
 empty virtual controller over a pseudo-terminal, then flashes it again
 unchanged, counting the bytes both ways at the host's serial port. The
-minimum (issue 4, Speed) is one read-back of every slot for the backup
-(`TM` and `TZ` with their answers), the MD lines themselves, and one
-read-back of each written macro. At 9600 baud a byte is 10 bits (8N1), so
-bytes are time. Exit 1 when a goal is missed: an unchanged re-flash must
+minimum is one read-back of every slot for the backup (`TM` and `TZ` with their
+answers), the MD lines themselves, and one read-back of each written macro. At 9600 baud a
+byte is 10 bits (8N1), so bytes are time. Exit 1 when a goal is missed: an unchanged re-flash must
 write no macro, a full flash must stay within 1.15x the minimum.
 
-The rig case (issue 18) flashes examples/rigs/raster/ to an empty virtual
+The rig case flashes examples/rigs/raster/ to an empty virtual
 two-controller chain on one pty in one run, and its minimum is, per controller,
 one address selection code (only where the target changes), VE and its answer
 (each controller is identified: its model must be the rig's), the backup read,

@@ -1,10 +1,10 @@
-"""`mercmac fmt` on large files: wall time and peak memory (issue 20, "slow but finishing").
+"""`mercmac fmt` on large files: wall time and peak memory (slow at worst, never stuck).
 
     python benchmarks/fmt_large.py [--size MB] [--timeout S]
 
 Four generated files of about 1 MB each, written the way people do not (lower case, no
 blanks), so that every one is rewritten, each formatted in a fresh interpreter:
-(a) one line: a macro of `mr 1` commands on a single line (the issue's case: 38 s);
+(a) one line: a macro of `mr 1` commands on a single line (once 38 s);
 (b) many lines: short high-level macros, one per line;
 (c) one raw line: `[MC01] mr1,mr1,...` on a single line;
 (d) many raw lines: MMCRun blocks, one per line.

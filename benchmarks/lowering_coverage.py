@@ -1,4 +1,4 @@
-"""How much of the high-level language the compiler fits (issue 8).
+"""How much of the high-level language the compiler fits.
 
 Generates random high-level programs from a fixed seed (leaf macros, macros
 that call and goto, modes, nested when/repeat/every, long bodies, loops at a
@@ -6,8 +6,8 @@ macro's start, big counts and periods), compiles each, and prints:
 
 - the share accepted (no error), and the rules that rejected the rest;
 - miscompilations: accepted programs whose MD lines, run on the firmware
-  model of SPEC §3 (tests/semantics.py), differ from the structured meaning
-  of the source for any of the 16 combinations of held buttons 1-4;
+  model (tests/helpers/semantics.py, docs/simulator.md), differ from the structured
+  meaning of the source for any of the 16 combinations of held buttons 1-4;
 - the slots used by the programs accepted.
 
 `--save FILE` keeps the per-program results; `--compare FILE` prints how
@@ -18,8 +18,9 @@ saved on the programs both runs accepted.
         --compare benchmarks/lowering_coverage.before.json
 
 `lowering_coverage.before.json` holds the results of the compiler before
-issue 8 (seed 8, 3400 programs): 1309 accepted (38.5 %); rejected with
-nested-call 1910, syntax 1290, argument-range 396; 0 miscompiled; 8026 slots.
+it lowered nested calls and in-line loops (seed 8, 3400 programs): 1309 accepted
+(38.5 %); rejected with nested-call 1910, syntax 1290, argument-range 396; 0 miscompiled;
+8026 slots.
 """
 from __future__ import annotations
 

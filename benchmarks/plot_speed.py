@@ -1,4 +1,4 @@
-"""`sim --plot` speed and file sizes against the simulation alone (issue 20, Slow).
+"""`sim --plot` speed and file sizes against the simulation alone.
 
     python benchmarks/plot_speed.py
 
@@ -12,7 +12,7 @@ the wall time on a shared machine) and the sizes of the files:
 (c) the same with a move per press (`MR 2000`): a profile sampled under a 1-ms poll;
 (d) 5,000 presses 20 s apart: 5,000 fast-forwarded stretches drawn compressed;
 (e) a program that moves twice and ends at 2.8 s, run for a day: its idle tail
-    drawn compressed (issue 16).
+    drawn compressed.
 Goal: the plot costs about what the simulation does (linear), at most ~2 s per MB
 of input; the page stays one file of a few MB.
 """

@@ -1,4 +1,4 @@
-"""Re-checking on every keystroke in the language server (issue 10, `mercmac lsp`).
+"""Re-checking on every keystroke in the language server (`mercmac lsp`).
 
     python benchmarks/recheck_latency.py [--runs N] [--big MB]
 
@@ -8,7 +8,7 @@ the largest example in examples/macros/, and a generated program that fills all 
 Prints the median re-check beside the median full `compile_source` of the same texts.
 Goal: median re-check at most 3 ms each.
 
-Then a large document (issue 20: 2.5 MB, 11.3 s to the first diagnostics and 3.5 s per
+Then a large document (2.5 MB; once 11.3 s to the first diagnostics and 3.5 s per
 edit) through a real `mercmac lsp` over pipes: the time from didOpen to the first
 diagnostics, from each one-character didChange to its diagnostics, and for a burst of
 edits sent at once, to the diagnostics of the last. Goal: linear, at most 2 s per MB.

@@ -1,5 +1,5 @@
-"""A rig's fast-forward against the single controller's when no pass changes a wire (issue 25,
-item 12): one program, `macro spin { CN 1, CF 1, goto spin }` from the autostart macro,
+"""A rig's fast-forward against the single controller's when no pass changes a wire:
+one program, `macro spin { CN 1, CF 1, goto spin }` from the autostart macro,
 
     python benchmarks/rig_spin.py [--until 1500d]
 

@@ -1,4 +1,4 @@
-"""Simulator speed: simulated time over wall time, start-up included (issue 3, Speed).
+"""Simulator speed: simulated time over wall time, start-up included.
 
     python benchmarks/sim_speed.py
 
@@ -8,7 +8,7 @@
 Each case runs in a fresh interpreter, so the wall time includes start-up
 (imports, compiling the file). Goal: at most 2 s of wall time each.
 
-Loops whose passes are identical except for what they emit (issue 7, item 7),
+Loops whose passes are identical except for what they emit,
 one simulated day each (goal: a second or two), and 100,000 presses at one
 instant (goal: well under a second, measured in-process):
 (c) a `goto` ping-pong without any wait (a busy loop);
@@ -17,24 +17,24 @@ instant (goal: well under a second, measured in-process):
 `--short` runs (c)-(e) for less simulated time (for the slow code before the
 fix) and prints the wall time scaled to a simulated day.
 
-Loops whose passes differ by a constant shift of position and target (issue 11,
-item 3), 1500 simulated days each (goal: under 2 s of wall time each):
+Loops whose passes differ by a constant shift of position and target,
+1500 simulated days each (goal: under 2 s of wall time each):
 (f) `every 10ms { MR 1, WS 0 }`: a scan stepping forever (into the soft limit);
 (g) Example 4 in mode 1 with button 1 held from power-on (`--buttons 1@0`);
-(g') `every 10ms { MR 1, WS 0, TS }` from -3000, across the reference edge (issue 19).
+(g') `every 10ms { MR 1, WS 0, TS }` from -3000, across the reference edge.
 
-Loops that report or move while the stage moves (issue 19), 1500 simulated days each on
+Loops that report or move while the stage moves, 1500 simulated days each on
 the C-863 and the C-663 (goal: at most 2 s of wall time each); each is first run for ten
-simulated minutes (the issue's table), and the 1500-day run is given up after MOVING_GIVE_UP
+simulated minutes, and the 1500-day run is given up after MOVING_GIVE_UP
 seconds (printed as "over"), so that a loop that is not skipped does not run for days:
 (i) `macro m { TT, MR 1, when 4 { goto fin }, goto m }`: reports between short moves;
 (j) `every 30ms { TT, MR 1, TT, MR 2, ... TT, MR 9 }`: a long body that reports.
 
-A rig (issue 18 §3, goal: at most 2 s of wall time):
+A rig (goal: at most 2 s of wall time):
 (h) the raster example (examples/rigs/raster/), one simulated hour from button 1 on X:
     both controllers on one clock, joint fast-forward on; then in-process, the same hour
     stepped (joint fast-forward off) for the ratio; and the same to 1500 simulated days
-    (issue 19; not stepped).
+    (not stepped).
 """
 from __future__ import annotations
 

@@ -64,7 +64,7 @@ class Command(NamedTuple):
     lo: int | None = None
     hi: int | None = None
     default: int | None = None  # what the controller substitutes when omitted
-    note_default: bool = False  # omitted argument deserves an info (SPEC §2)
+    note_default: bool = False  # omitted argument deserves an info (docs/checks.md)
     models: frozenset = BOTH
     report: str | None = None  # report identifier, e.g. "P:"
     storable: bool = True  # may stand in a macro (MS176E §3.8, §6.4 RT)

@@ -1,5 +1,5 @@
 """Project settings for `check` and the language server: `[tool.mercmac]` in pyproject.toml,
-or a mercmac.toml, found upward from the file being checked (SPEC §5).
+or a mercmac.toml, found upward from the file being checked (docs/cli.md).
 
     [tool.mercmac]                 # in mercmac.toml: the same keys, without the table line
     target = "C-863"               # a default for --target
@@ -14,7 +14,7 @@ A settings file is UTF-8 TOML, read by mercmac.tomlfile as scenarios and rigs ar
 leading UTF-8 byte-order mark is read past, as ruff and Cargo read one (Windows editors
 write it; TOML 1.0 does not forbid it, tomllib alone refuses it). Only a regular file is
 read, and at most mercmac.source.MAX_BYTES of it: a FIFO or a link to /dev/zero is named,
-not waited on (issue 20). Whatever is wrong with a settings file stops `check` with a
+not waited on. Whatever is wrong with a settings file stops `check` with a
 message naming the file (exit 2).
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Diagnostics are data: the rules of SPEC §2, each with a stable code, its message
+"""Diagnostics are data: the rules (docs/checks.md), each with a stable code, its message
 templates and its story (pyflakes `messages.py`, ruff's rule text beside the rule).
 
 Checks only call `Report.add(rule, span, variant, **values)` and carry on: the
@@ -319,7 +319,7 @@ remove the comment. Only `check` reads these comments.""", {
         "empty": "`mercmac: ignore[]` names no rule, so it turns nothing off: name the rules, "
                  "or write `// mercmac: ignore` for every rule on the line",
     }),
-    # -- rigs (issue 18, SPEC §6): the rig file, checked by mercmac/rig/checks.py --
+    # -- rigs (docs/rigs.md): the rig file, checked by mercmac/rig/checks.py --
     Rule("MR001", "rig-file", _E, "the rig file cannot be read as a rig", """\
 A rig file (`NAME.rig.toml`) is UTF-8 TOML with the keys the README's "Rigs"
 section lists: `name`, `box`, `box_buttons`, `wires`, a `[joystick]` table and

@@ -1,4 +1,4 @@
-"""The library's errors: what went wrong, in words the user can act on (SPEC §5).
+"""The library's errors: what went wrong, in words the user can act on (docs/cli.md).
 
 Each kind carries the exit code a command ends with; `mercmac.cli.common.run_guarded` is
 the one place that turns them into a message and that code. The library raises these
@@ -7,14 +7,14 @@ is the CLI's own, for options that do not go together.
 
     MercmacError    a check, simulation or upload that failed              exit 1
     InputError      an option or setting value, a file that cannot be      exit 2
-                    read or written (SPEC §5: usage/IO)
+                    read or written (docs/cli.md, "Exit codes": usage/IO)
     SettingsError   a rule selection, model or settings file checking      exit 2
                     cannot take (config, suppress, the editor's settings)
     Interrupted     a signal cut the work short (Ctrl-C, SIGTERM or        exit 128+N
                     SIGHUP); the message says how far                      (130, 143, 129)
 
 SIGTERM and SIGHUP reach the library as `Signalled`, a KeyboardInterrupt: whatever tidies
-up after Ctrl-C (a flash's report, a simulation cut short) does the same for them (SPEC §5).
+up after Ctrl-C (a flash's report, a simulation cut short) does the same for them (docs/cli.md).
 """
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 folder (`check DIR`, `fmt DIR`).
 
 Below a folder only regular files are taken: a FIFO would block its reader for good and a
-device never ends (issue 20), so they are named as skipped, as is every folder that
+device never ends, so they are named as skipped, as is every folder that
 cannot be read. Symbolic links to folders are not followed (os.walk's default), so a
 link loop ends the walk instead of running it forever. A file named on the command line
 is left to `mercmac.source.read_source`, which refuses what it cannot read.

@@ -1,4 +1,5 @@
-"""Syntax highlighting of `.mcm` (SPEC §1): a Pygments lexer, and the TextMate grammar made from it.
+"""Syntax highlighting of `.mcm` (docs/language.md): a Pygments lexer, and the TextMate
+grammar made from it.
 
 `McmLexer` is registered under the `pygments.lexers` entry point, so rich, Sphinx and MkDocs
 highlight `.mcm` files; `mercmac check` uses it for the source line of a diagnostic on a

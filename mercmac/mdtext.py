@@ -4,8 +4,8 @@ A stored line is base commands separated by commas (MS176E §5.3): `MR5000,WS100
 `parse_line` reads one into `Op`s and says what is wrong with it, with the very
 validation `mercmac check` applies to a native command (both call `validate`);
 `format_ops` writes ops back; `canonical` is the line as the controller keeps it
-(SPEC §4); the wire builders (`md`, `tm`, `tz`, `rz`, `rm`, `rt`, `ve`) give every
-command line the uploader sends. The compiler, the VM, the emulator and the
+(docs/uploader.md, "Reading macros back"); the wire builders (`md`, `tm`, `tz`, `rz`, `rm`, `rt`,
+`ve`) give every command line the uploader sends. The compiler, the VM, the emulator and the
 uploader all read and write MD text here.
 
 Macro listings, too: `listed` reads the header of a line that names a macro by its slot
@@ -242,7 +242,7 @@ def _problem(item: Written, f: Finding) -> Problem:
 
 def validate(word: str, value, *, model: str | None = None, stored: bool = True,
              slot: int | None = None) -> Checked:
-    """Check one native command against the command table (SPEC §2).
+    """Check one native command against the command table (docs/checks.md).
 
     `value` is None (omitted), an int, or anything else that is no usable number (a
     word, TooLong). No op when the command or its argument is wrong; one that may not
@@ -251,7 +251,7 @@ def validate(word: str, value, *, model: str | None = None, stored: bool = True,
     return _validate(word, value, model, stored, slot)
 
 
-# Files repeat a few commands many times (issue 7: 1 MB of them): check each once.
+# Files repeat a few commands many times (1 MB of them): check each once.
 @functools.lru_cache(maxsize=4096)
 def _validate(word: str, value, model: str | None, stored: bool, slot: int | None) -> Checked:
     spec = lookup(word)
@@ -323,7 +323,8 @@ def format_ops(ops: Iterable[Op]) -> str:
 
 
 def canonical(text: str) -> str:
-    """A line as the controller keeps it: upper case, blanks dropped (MS176E §5.2, SPEC §4)."""
+    """A line as the controller keeps it: upper case, blanks dropped (MS176E §5.2;
+    docs/uploader.md, "Reading macros back")."""
     return _BLANK.sub("", text.upper())
 
 
@@ -374,7 +375,7 @@ class Listed(NamedTuple):
 _LISTED = re.compile(
     _RAW.format(f"(?P<RAW>{_SLOT})")
     + r"|MD[ \t]*(?P<MD>[+-]?[ \t]*[0-9]+)[ \t]*(?:,|$)"
-    # TM writes three digits; one or two before a blank are read too (SPEC §4)
+    # TM writes three digits; one or two before a blank are read too (docs/uploader.md)
     + r"|MC\s*(?P<TM>[0-9]{3}|[0-9]{1,2}(?=\s|$))(?:\s+|$)", re.IGNORECASE)
 _FORMS = (None, Form.RAW, Form.MD, Form.TM)  # by the group of the form's slot number
 

@@ -1,4 +1,4 @@
-"""Names from outside as each output shows them (issue 25 item 14): a file name, a rig's or
+"""Names from outside as each output shows them: a file name, a rig's or
 a controller's name, a port, what the flash history recalls. Such a name may hold any
 character a file system or an old record allows: an ESC sequence that clears the screen or
 writes the clipboard (OSC 52), a CR or a newline that forges an output line, a bidirectional
@@ -22,7 +22,7 @@ _HIDDEN |= {c: f"\\u{c:04x}" for c in (0x2028, 0x2029, *range(0x200B, 0x2010),
 _HIDDEN[0x09] = " "  # a tab shows as one space, so the caret stays under its column
 # A file name that is not UTF-8 holds its bytes as lone surrogates (os.fsdecode's
 # surrogateescape, U+DC80-U+DCFF for bytes 0x80-0xFF): shown as the byte, `\xff`; no
-# stream can write a lone surrogate as UTF-8 (issue 20).
+# stream can write a lone surrogate as UTF-8.
 SURROGATES = {c: f"\\u{c:04x}" for c in range(0xD800, 0xE000)}
 SURROGATES |= {0xDC00 + b: f"\\x{b:02x}" for b in range(0x80, 0x100)}
 _HIDDEN |= SURROGATES

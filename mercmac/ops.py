@@ -4,7 +4,7 @@ where a macro came from (`Origin`).
 A foundation module: mercmac.mdtext reads MD text into Ops, the compiler lowers a program
 to them (mercmac.compiler.program), the VM, the emulator and the uploader run and send
 them. It imports nothing of mercmac but the source positions, so none of those import
-each other to name an Op (issue 17: mdtext and compiler.program imported each other).
+each other to name an Op (mdtext and compiler.program imported each other).
 """
 from __future__ import annotations
 

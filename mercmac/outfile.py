@@ -7,7 +7,7 @@ complete; on any failure, Ctrl-C, SIGTERM and SIGHUP included, the temporary fil
 and the old file is untouched.
 
 A file with more than one name (hard links) is written in place instead, so that every
-name sees the new text (issue 20): the new bytes are complete on disk first, the old
+name sees the new text: the new bytes are complete on disk first, the old
 bytes are copied beside the file, the space is reserved, and only then is the file
 overwritten and cut to length, with Ctrl-C, SIGTERM and SIGHUP held off. If that fails (an I/O
 error) the old bytes are written back; if even that fails, or the machine stops midway,
@@ -75,7 +75,7 @@ class Snapshot(NamedTuple):
 def snapshot(path: str | os.PathLike, data: bytes) -> Snapshot:
     """The snapshot of PATH, just read as DATA (stat after the read: a change in between
     shows as a size or a digest that does not match)."""
-    import hashlib  # here: a run that writes no file does not import it (start-up, issue 19)
+    import hashlib  # here: a run that writes no file does not import it (start-up)
 
     return Snapshot(len(data), os.stat(path).st_mtime_ns, hashlib.sha256(data).digest())
 
@@ -316,7 +316,7 @@ def write_text(path: str | os.PathLike, text: str, *, encoding: str = "utf-8",
 
 
 def _unchanged(target: Path, expect: Snapshot | None, path) -> None:
-    """OutputError unless TARGET still holds what EXPECT says was read (issue 20: `fmt`
+    """OutputError unless TARGET still holds what EXPECT says was read (`fmt`
     of a large file takes a while, and an editor may save meanwhile)."""
     if expect is None:
         return

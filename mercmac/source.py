@@ -11,7 +11,7 @@ from typing import NamedTuple
 from mercmac.errors import InputError
 from mercmac.outfile import kind
 
-# The one definition of a line end in mercmac (SPEC §5): LF, CRLF or a lone CR, mixed freely,
+# The one definition of a line end in mercmac (docs/cli.md): LF, CRLF or a lone CR, mixed freely,
 # as the LSP specification and editors count lines. Form feeds, vertical tabs, U+0085,
 # U+2028 and U+2029 end no line (str.splitlines would split there; editors do not).
 LINE_END = re.compile(r"\r\n|\r|\n")
@@ -67,7 +67,7 @@ class Source:
 
 # The largest .mcm file read: 32 macros of 16 commands fit in a few kB, and the largest file a
 # person keeps (comments, names, rigs) in well under a MB; the cap stops a device such as
-# /dev/zero, or a wrong file, from filling the memory (issue 20).
+# /dev/zero, or a wrong file, from filling the memory.
 MAX_BYTES = 16 * 1024 * 1024
 
 
@@ -204,7 +204,7 @@ def decode(data: bytes) -> str:
 
 def decode_exact(data: bytes) -> tuple[str, Encoding]:
     """A file's text and encoding such that `encoding.write(text) == data`, or EncodingError
-    naming the first byte that does not read (issue 20: `fmt` never writes U+FFFD back)."""
+    naming the first byte that does not read (`fmt` never writes U+FFFD back)."""
     encoding = encoding_of(data)
     try:
         text = encoding.read(data)

@@ -20,7 +20,7 @@ from mercmac.source import Source, Span, split_lines
 # `// mercmac: ignore` (every rule) or `// mercmac: ignore[MM011, undefined-macro]`, in any
 # case. Matched inside a line's comment only, and without backtracking: the codes run to
 # the first `]` or the end of the line (group 2 empty: unclosed), so a line of repeated
-# `//` or `[` costs one pass (issue 20: a lazy `//.*?` before it was quadratic).
+# `//` or `[` costs one pass (a lazy `//.*?` before it was quadratic).
 _DIRECTIVE = re.compile(r"\bmercmac:[ \t]*ignore\b(?:[ \t]*\[([^\]]*)(\]?))?", re.IGNORECASE)
 _MENTION = re.compile("mercmac", re.IGNORECASE)
 _KEPT = "syntax"
@@ -51,7 +51,7 @@ def rule_set(keys: Iterable[str], option: str) -> frozenset[str]:
 
 def selection(keys: Iterable[str], option: str) -> frozenset[str]:
     """rule_set for a selection, refused when it names no rule: it would report nothing
-    and pass, which is never what `--select ''` or `select = []` meant (issue 20)."""
+    and pass, which is never what `--select ''` or `select = []` meant."""
     codes = rule_set(keys, option)
     if not codes:
         raise SettingsError(f"{option} names no rule, so nothing would be reported",

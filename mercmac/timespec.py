@@ -1,4 +1,4 @@
-"""Durations (`20ms`, `1.5s`, `1500d`), button scripts (SPEC §5 `--buttons`), and the one way
+"""Durations (`20ms`, `1.5s`, `1500d`), button scripts (`--buttons`, docs/cli.md), and the one way
 times are written for people: `format_span` (a length) and `format_clock` (a time on the run's
 clock). Every number goes with its unit after a space, as `--until` takes it: `1.5 s`, `31.7 min`,
 `1,500 d`; a clock from 1000 s on reads `1 d 1:01:01.5`."""
@@ -10,8 +10,9 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 UNIT_MS = {"ms": 1, "s": 1000, "min": 60_000, "h": 3_600_000, "d": 86_400_000}
-# 100 years: far beyond any bench run (SPEC's `--until 1500d` is ~4 years), and small enough
-# that times in microseconds stay exact in a float and far from any int64 limit.
+# 100 years: far beyond any bench run (`--until 1500d`, the longest the benchmarks run, is
+# ~4 years), and small enough that times in microseconds stay exact in a float and far from
+# any int64 limit.
 MAX_MS = 36_525 * UNIT_MS["d"]
 MAX_DIGITS = 40  # longer numbers are out of range anyway; int() refuses > 4300 digits
 # ASCII digits only: int() would also take other scripts' digits, which nobody means here

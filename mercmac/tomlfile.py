@@ -1,5 +1,5 @@
 """Reading a TOML file: the one reader of settings (mercmac.config), scenarios
-(mercmac.sim.scenario) and rig files (mercmac.rig.load), with one set of guards (issue 25).
+(mercmac.sim.scenario) and rig files (mercmac.rig.load), with one set of guards.
 
     path --read_text: a regular file, capped, UTF-8 (or UTF-16 with its mark)--> text
          --loads: tomllib (tomli on Python 3.10), every failure a TomlError with its place--> table
@@ -8,7 +8,7 @@ Only a regular file is read, and at most mercmac.source.MAX_BYTES of it (read_by
 a link to /dev/zero is named, not waited on). TOML 1.0 files are UTF-8; a leading UTF-8
 byte-order mark is read past, as ruff and Cargo read one (Windows editors write it), and a
 file that starts with a UTF-16 mark (Notepad's "Unicode") says which text it is. Line ends
-are LF, CRLF or a lone CR, read alike (SPEC §5). Each caller words a TomlError its own way.
+are LF, CRLF or a lone CR, read alike (docs/cli.md). Each caller words a TomlError its own way.
 
 tomllib is imported when a file is read, never at import: `check` of .mcm files starts
 without it (benchmarks/check_latency.py).
@@ -78,7 +78,7 @@ def loads(text: str) -> dict:
     from mercmac.source import to_lf
 
     tomllib = _tomllib()
-    text = to_lf(text)  # a lone CR ends a line too (SPEC §5), as in every other file read
+    text = to_lf(text)  # a lone CR ends a line too (docs/cli.md), as in every other file read
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:

@@ -1,4 +1,5 @@
-"""One command table (STYLE.md practice 3): nothing outside mercmac/commands.py lists mnemonics.
+"""One command table (docs/architecture.md, "One table, one model, one renderer"): nothing
+outside mercmac/commands.py lists mnemonics.
 
 Every module under mercmac/ is read with `ast`: a string constant that is a mnemonic of the
 table (docstrings aside) is a second list; code names a command `Mnemonic.EM` or reads the

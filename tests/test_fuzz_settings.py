@@ -1,4 +1,4 @@
-"""Hostile settings files through the real `mercmac check` (issue 20): random TOML-ish text,
+"""Hostile settings files through the real `mercmac check`: random TOML-ish text,
 deep nesting, wrong types, byte-order marks and binary as `mercmac.toml` or as
 `pyproject.toml`. Whatever the file holds, `check` ends with 0, 1 or 2; a 2 names the
 settings file; never a traceback."""

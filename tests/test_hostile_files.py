@@ -1,4 +1,4 @@
-"""Output paths that are not plain files (issue 7): nothing lost, nothing hangs, no traceback.
+"""Output paths that are not plain files: nothing lost, nothing hangs, no traceback.
 
 `build -o`, `flash --backup` and `pull -o` write whole files or nothing, only where a regular
 file belongs: a device or a FIFO is refused before the controller is touched, a symlink is
@@ -286,7 +286,7 @@ def test_an_unwritable_folder_is_named(tmp_path, program_file):
 
 
 def test_a_read_only_folder_is_refused_by_its_mode_even_as_root(tmp_path, program_file):
-    """Issue 25: root writes into a 0555 folder, but the folder says it is not to change,
+    """Root writes into a 0555 folder, but the folder says it is not to change,
     as a 0444 file does; and no folder is made in it either."""
     ro = tmp_path / "ro"
     ro.mkdir()

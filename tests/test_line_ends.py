@@ -1,4 +1,4 @@
-"""One line end for every tool (issue 20, item 1; SPEC §5): LF, CRLF and a lone CR end a line
+"""One line end for every tool (docs/cli.md): LF, CRLF and a lone CR end a line
 alike in check, build, fmt and the highlighter, mixed freely, with the same lines and columns."""
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from mercmac.highlight import McmLexer
 from helpers.programs import programs
 
 EXAMPLE_TEXTS = [load(p.read_bytes())[0] for p in EXAMPLE_FILES]
-# The issue's file: the `//` comment ran to the next LF and hid the rest of the file.
+# A file that once went wrong: the `//` comment ran to the next LF and hid the rest of the file.
 CR_ONLY = b"macro a @20 { MR 5 }   // c\rautostart { call a }\r[MC05] MR 9\r"
 # Where the mercmac under test lives: a child process started there imports the same one.
 PACKAGE_ROOT = Path(mercmac.__file__).resolve().parent.parent
@@ -30,7 +30,7 @@ ENDS = st.sampled_from(["\n", "\r\n", "\r"])
 
 
 def split_lines(text: str, keepends: bool = False) -> list[str]:
-    """The test's own oracle of SPEC §5's line ends (not mercmac's)."""
+    """The test's own oracle of the line ends in docs/cli.md (not mercmac's)."""
     if keepends:
         return re.findall(r"[^\r\n]*(?:\r\n|\r|\n)", text)
     return re.split(r"\r\n|\r|\n", text)

@@ -1,4 +1,4 @@
-"""Macro listings (issue 17): one reader of `[MCnn]`, `MDn,` and TM lines, one header pattern.
+"""Macro listings: one reader of `[MCnn]`, `MDn,` and TM lines, one header pattern.
 
 `mercmac.mdtext.listed` reads every line that names a macro by its slot, `RAW_HEADER` is the
 one pattern of a raw block's header, `slot_name` and `tm_line` write a slot's name. The
@@ -44,7 +44,7 @@ TM_LINES = [f"{mc}{a}{digits}" for mc in ("MC", "mc") for a in ("", " ")
     ("MD5,MR5000,WS100", Form.MD, 5, 4, "MR5000,WS100"),
     ("md 5", Form.MD, 5, 4, ""),  # an empty definition
     ("MC001 MR55555", Form.TM, 1, 6, "MR55555"),
-    ("MC000", Form.TM, 0, 5, ""),  # an empty slot as a bare header (SPEC §4)
+    ("MC000", Form.TM, 0, 5, ""),  # an empty slot as a bare header (docs/uploader.md)
     ("MC5 TP", Form.TM, 5, 4, "TP"),
 ])
 def test_a_listing_line_is_read_as_its_form_slot_and_body(line, form, slot, header, body):

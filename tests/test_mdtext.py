@@ -1,6 +1,6 @@
-"""mercmac.mdtext: the one reader and writer of MD text (issue 9).
+"""mercmac.mdtext: the one reader and writer of MD text.
 
-Round trips, the canonical form of SPEC §4, the wire commands, and the property that the
+Round trips, the canonical form (docs/uploader.md), the wire commands, and the property that the
 emulator and `mercmac check` accept and refuse the same lines.
 """
 from __future__ import annotations
@@ -101,7 +101,7 @@ def test_parse_format_parse_is_a_round_trip(commands):
 
 
 @pytest.mark.parametrize("stored,meant", [
-    ("mr 5000, ws100", "MR5000,WS100"),  # SPEC §4: upper case, spaces dropped
+    ("mr 5000, ws100", "MR5000,WS100"),  # docs/uploader.md: upper case, spaces dropped
     ("EM+9,EM+10", "EM9,EM10"),  # what MMCRun wrote means what mercmac sends
     ("WA007", "WA7"),
     ("DI,", "DI"),

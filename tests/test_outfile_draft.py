@@ -1,5 +1,5 @@
 """outfile.drafting: the caller has the last word on whether the new file replaces the old
-one (issue 17: `sim --vcd` cut by Ctrl-C keeps the old dump without raising an exception
+one (`sim --vcd` cut by Ctrl-C keeps the old dump without raising an exception
 of its own to leave the block). Real files in a temporary folder."""
 from __future__ import annotations
 

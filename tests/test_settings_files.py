@@ -1,4 +1,4 @@
-"""Settings files under hostile or mistaken content (issue 20, items 13 and 15): an empty
+"""Settings files under hostile or mistaken content: an empty
 selection, the table in other TOML spellings, a byte-order mark, a file that cannot be
 read or is no regular file - each said with the file's name, exit 2, never a traceback."""
 from __future__ import annotations
@@ -129,7 +129,7 @@ def test_a_utf8_byte_order_mark_is_read_past(tmp_path):
     '\ufeffselect = ["MM012"]\n'.encode("utf-16-be"),
 ])
 def test_a_utf16_file_with_its_mark_is_read(tmp_path, data):
-    """Issue 25 item 11: settings, scenarios and rigs are read by one reader
+    """Settings, scenarios and rigs are read by one reader
     (mercmac.tomlfile), and a scenario in Notepad's "Unicode" was always read."""
     (tmp_path / "mercmac.toml").write_bytes(data)
     assert _rules(_check()) == ["undefined-macro"]
@@ -142,8 +142,8 @@ def test_utf16_that_does_not_read_is_named_as_such(tmp_path):
 
 
 def test_lone_cr_line_ends_are_read(tmp_path):
-    """Issue 25 item 11: settings are read by the one TOML reader (mercmac.tomlfile), which
-    reads LF, CRLF and lone CR line ends alike, as every other file (SPEC §5)."""
+    """Settings are read by the one TOML reader (mercmac.tomlfile), which
+    reads LF, CRLF and lone CR line ends alike, as every other file (docs/cli.md)."""
     (tmp_path / "mercmac.toml").write_bytes(b'target = "C-863"\rselect = ["MM012"]\r')
     assert _rules(_check()) == ["undefined-macro"]
 

@@ -1,4 +1,4 @@
-"""`// mercmac: ignore[...]` comments (issue 20, item 14): a comment that cannot be read
+"""`// mercmac: ignore[...]` comments: a comment that cannot be read
 turns nothing off and is reported (invalid-suppression); codes and names in any case."""
 from __future__ import annotations
 
@@ -82,7 +82,7 @@ def test_the_warning_points_at_the_directive(tmp_path):
 
 
 def test_a_line_of_many_comment_starts_is_read(tmp_path):
-    """The shape that made the old pattern quadratic (issue 20, item 8; its time is in
+    """The shape that made the old pattern quadratic (its time is in
     benchmarks/check_large.py): the directive at the end still counts, once."""
     comment = "// " * 2000 + "mercmac: ignore[MM011"
     code, found = _check(tmp_path, comment)

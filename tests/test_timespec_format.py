@@ -1,4 +1,4 @@
-"""One way to write a time for people (issue 17 §3): `timespec.format_span` for a length and
+"""One way to write a time for people: `timespec.format_span` for a length and
 `timespec.format_clock` for a time on the run's clock, used by the timeline, the plot, the
 progress lines, describe and the language server; no module keeps a formatter of its own."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The one TOML reader (mercmac/tomlfile.py, issue 25 item 11): settings, scenarios and rigs
+"""The one TOML reader (mercmac/tomlfile.py): settings, scenarios and rigs
 are read with the same guards, each failure a TomlError with its place, never a traceback;
 on Python 3.10, which has no tomllib, tomli reads them."""
 from __future__ import annotations
@@ -18,7 +18,7 @@ HUGE = "9" * 5000  # int() refuses more than 4300 digits (sys.get_int_max_str_di
 @pytest.mark.parametrize("text, line, column, words", [
     ("a = 1\nb = [\n", 3, 1, "not valid TOML"),  # at the end of the document
     ("a = 1\nb = ?\n", 2, 5, "not valid TOML"),
-    ("a = 1\rb = ?\r", 2, 5, "not valid TOML"),  # a lone CR ends a line (SPEC §5)
+    ("a = 1\rb = ?\r", 2, 5, "not valid TOML"),  # a lone CR ends a line (docs/cli.md)
     (f"a = 1\nb = [1, {HUGE}]\n", 2, 9, "too many digits"),
     (f"a = 1\n[t]\nb = -{HUGE}\n", 3, 6, "too many digits"),
 ])

@@ -1,4 +1,4 @@
-"""The README's test command in a fresh clone, on a machine kept busy (issue 26).
+"""The README's test command in a fresh clone, on a machine kept busy.
 
 Clones this repository's committed HEAD into a temporary folder and runs the README's second
 set-up line there (as .ci/run and tests/project/test_readme.py read it) RUNS times in a row,

@@ -1,4 +1,4 @@
-"""The `mercmac` command: a thin click layer over the importable API (SPEC §5).
+"""The `mercmac` command: a thin click layer over the importable API (docs/cli.md).
 
 Commands parse options and call the library; `run_guarded` is the one place
 that turns exceptions into a message and an exit code.

@@ -107,7 +107,7 @@ def _report_cut_short(interrupt: KeyboardInterrupt) -> MercmacError | None:
 
 def _catch_signals() -> dict | None:
     """While the work runs, Ctrl-C raises KeyboardInterrupt and SIGTERM or SIGHUP raise
-    Signalled, so that whatever tidies up after Ctrl-C answers all three alike (SPEC §5).
+    Signalled, so that whatever tidies up after Ctrl-C answers all three alike (docs/cli.md).
     A signal the process ignores (started by `nohup`, or with `&`) stays ignored. The handlers
     before, by signal number, to put back; None off the main thread, where they are not
     ours to change."""

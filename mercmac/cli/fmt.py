@@ -11,8 +11,8 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK, EXIT_USAGE
 
 
 def format_files(files: tuple[str, ...], *, check: bool, diff: bool) -> int:
-    """Format FILES; the exit code (SPEC §5): 2 if any could not be done, else 1 if
-    --check/--diff found one that would change, else 0."""
+    """Format FILES; the exit code (docs/cli.md, "Exit codes"): 2 if any could not be done,
+    else 1 if --check/--diff found one that would change, else 0."""
     paths, failed = _programs(files)
     changed = unchanged = 0
     for path in paths:
@@ -30,7 +30,7 @@ def format_files(files: tuple[str, ...], *, check: bool, diff: bool) -> int:
 
 
 def _programs(files: tuple[str, ...]) -> tuple[list[str], int]:
-    """FILES with each rig file (`*.rig.toml`, SPEC §6) in the place of its programs, and
+    """FILES with each rig file (`*.rig.toml`, docs/rigs.md) in the place of its programs, and
     how many rig files could not be read (each said). The rig file itself is TOML that
     the user wrote: fmt leaves it as written."""
     import os

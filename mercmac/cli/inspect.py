@@ -1,4 +1,4 @@
-"""`mercmac decompile`, `describe` and `history`: what a file or a controller holds (SPEC §5).
+"""`mercmac decompile`, `describe` and `history`: what a file or a controller holds (docs/cli.md).
 
 The macros come from a .mcm file (raw `[MCnn]` blocks such as a pull or a backup, or
 a program) or from the controller on --port. A controller that holds exactly a

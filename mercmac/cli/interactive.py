@@ -1,4 +1,4 @@
-"""`sim --interactive`: a live C-170.PB pushbutton box in the terminal (issues 3 and 11).
+"""`sim --interactive`: a live C-170.PB pushbutton box in the terminal.
 
 Before power-on a short count-down lets keys 1-6 choose the inputs held at
 power-on (what the manual's Example 4 reads to select a mode); `--hold 2`

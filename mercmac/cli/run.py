@@ -59,7 +59,7 @@ def run(req: Request) -> bool:
 def _run(req: Request) -> bool:
     from mercmac.rig import is_rig_path
 
-    if is_rig_path(req.file):  # every controller of the rig on one clock (issue 18)
+    if is_rig_path(req.file):  # every controller of the rig on one clock
         from mercmac.cli import run_rig
 
         return run_rig.run(req)

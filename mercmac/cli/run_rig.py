@@ -1,4 +1,4 @@
-"""The work of `mercmac sim RIG` (issue 18 §3, SPEC §6): the rig file and its programs in,
+"""The work of `mercmac sim RIG` (docs/rigs.md): the rig file and its programs in,
 every controller on one clock (sim/rig.py), the merged timeline or JSON out.
 
 `--buttons NAME:B@T1-T2` presses button B of the box, which must be plugged into controller

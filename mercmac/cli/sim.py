@@ -1,4 +1,4 @@
-"""`mercmac sim`: options in, the simulator library does the work (SPEC §5).
+"""`mercmac sim`: options in, the simulator library does the work (docs/cli.md).
 
 Heavy modules (the VM, rich, pyvcd) are imported inside the command, so that
 `mercmac check`, which imports this module, starts fast.

@@ -1,4 +1,5 @@
-"""`mercmac flash`, `pull`, `ports`, `scan` and `emulate`: thin click commands (SPEC §4, §5).
+"""`mercmac flash`, `pull`, `ports`, `scan` and `emulate`: thin click commands
+(docs/uploader.md, docs/cli.md).
 
 The serial library, rich and the uploader are imported inside the command
 bodies so that `mercmac check` starts fast.
@@ -402,7 +403,7 @@ def pull_rig(port: str, folder: Path, baud: int, timeout: float, text_of, *,
     """Scan PORT, read every controller, write FOLDER/NAME.rig.toml and NAME.mcm for each;
     `text_of(member)`: a controller's .mcm text (stored macros, source, decompiled) and
     what it is, for the table. Every file is checked before the first is written; one that
-    is there already is replaced only with FORCE (SPEC §6), a symlink never."""
+    is there already is replaced only with FORCE (docs/rigs.md), a symlink never."""
     from mercmac import outfile
     from mercmac.render import upload as view
     from mercmac.render.console import write_lines
@@ -636,7 +637,7 @@ def _virtual(model: str, address: int, addresses: tuple[int, ...] | None, rig_pa
 
 
 def _emulated_rig(path: str):
-    """The rig at PATH when `check` finds no errors in it (SPEC §6); else what `check`
+    """The rig at PATH when `check` finds no errors in it (docs/rigs.md); else what `check`
     finds is shown as `check` shows it, and nothing is served (exit 1, as `sim RIG`)."""
     from mercmac.render.report import write_findings
     from mercmac.rig.accept import ProgramsUnread, RigRefused, accept

@@ -1,4 +1,5 @@
-"""The compiler: .mcm text -> diagnostics and the lowered program (SPEC §1, §2).
+"""The compiler: .mcm text -> diagnostics and the lowered program
+(docs/language.md, docs/checks.md).
 
     source --parse--> tree --build--> AST --check--> Env --lower--> Program --flow checks
 """
@@ -51,7 +52,7 @@ def compile_source(source: Source, target: str | None = None) -> Compilation:
 
 def _check_partial(source: Source, module, broken: frozenset[int], report: Report,
                    target: str | None) -> None:
-    """The checks of a file with broken lines (issue 10): every line that parsed is checked
+    """The checks of a file with broken lines: every line that parsed is checked
     as in a whole file, so that one line being typed hides nothing on the others.
 
     - What a broken line held up to its error is not checked: its diagnostics are the

@@ -1,7 +1,7 @@
-"""The syntax tree of a .mcm file: immutable records with spans (SPEC §1).
+"""The syntax tree of a .mcm file: immutable records with spans (docs/language.md).
 
 NamedTuples rather than dataclasses: they are several times cheaper to
-define, and `mercmac check` runs on every save (issue 2, Speed).
+define, and `mercmac check` runs on every save.
 """
 from __future__ import annotations
 

@@ -1,9 +1,9 @@
 """Parse tree -> AST: one function per rule of grammar.lark builds its node with its span.
 
 Two readers call them, with the same span and children: `parse.read`, which builds the AST
-while it reads a file that parses (issue 20: several times faster than a tree, then a
+while it reads a file that parses (several times faster than a tree, then a
 Transformer), and lark's Transformer over the tree of a file with syntax errors, which only
-lark's parser reads past (`parse.parse_partial`, issue 10).
+lark's parser reads past (`parse.parse_partial`).
 """
 from __future__ import annotations
 
@@ -163,7 +163,7 @@ def build(tree) -> ast.Module:
 
 def parse_module(text: str, report: Report) -> Parsed:
     """Parsed with the AST of TEXT as its tree: read in one pass when the file parses, else
-    by `parse_partial`, which reports every syntax error and reads past them (issue 10)."""
+    by `parse_partial`, which reports every syntax error and reads past them."""
     with paused_gc():
         module = read(text, RULES)
     if module is not None:

@@ -1,5 +1,5 @@
 """What `mercmac check` reports for one source: the one function that `check` and the
-language server both call, so that an editor shows what `check` says (issue 16).
+language server both call, so that an editor shows what `check` says.
 
     source --compile--> every finding --rules chosen, comments read--> what is reported
 
@@ -90,7 +90,7 @@ def _guarded(compiler, source: Source, target: str | None) -> Compilation:
     """Compile one file; a compiler bug becomes an error on that file, and the others go on."""
     try:
         return compiler(source, target)
-    except Exception as e:  # last resort (issue 7): never a traceback, never lose the other files
+    except Exception as e:  # last resort: never a traceback, never lose the other files
         report = Report(source.name)
         try:
             detail = f"{type(e).__name__}: {e}"

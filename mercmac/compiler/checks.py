@@ -1,4 +1,4 @@
-"""Checks on the syntax tree: commands, arguments, names and slots (SPEC §2).
+"""Checks on the syntax tree: commands, arguments, names and slots (docs/checks.md).
 
 The pass also resolves what lowering needs: each valid native command as an
 `Op`, each `const`, each named macro. Checks only report and carry on.
@@ -27,7 +27,7 @@ class Env:
 
     def __init__(self, target: str | None = None, unsure: frozenset[str] = frozenset()):
         self.target = target
-        # names a broken line may define (issue 10): not reported as undefined
+        # names a broken line may define: not reported as undefined
         self.unsure = unsure
         self.consts: dict[str, int] = {}
         self.macros: dict[str, ast.MacroDef] = {}
@@ -260,7 +260,7 @@ def _unknown_hint(word: str, argument: str | None, kind: type, raw: bool, spelli
     return spelling, guess
 
 
-_NAMING = ("call", "goto")  # the keywords a statement `KEYWORD NAME` starts with (SPEC §1)
+_NAMING = ("call", "goto")  # the keywords a statement `KEYWORD NAME` starts with (docs/language.md)
 
 
 def _argument(value) -> str | None:

@@ -1,4 +1,4 @@
-"""`check --fix`: the safe fixes of what `check` reports, applied to the text (issue 17).
+"""`check --fix`: the safe fixes of what `check` reports, applied to the text.
 
     source --check--> findings with Fix data --applied, checked again--> fixed text
 
@@ -81,7 +81,7 @@ def fix_file(path: str, chosen: Options = Options(), *, write: bool = True) -> F
 
 def _encoding(data: bytes, name: str):
     """The file's encoding, that writes its text back as these bytes; InputError naming
-    the first byte that does not read (a U+FFFD is never written back: issue 20)."""
+    the first byte that does not read (a U+FFFD is never written back)."""
     from mercmac.source import EncodingError, decode_exact
 
     try:

@@ -1,5 +1,5 @@
 """Words a newcomer writes for what the controller spells otherwise: `LED 1`, `wait 100ms`,
-`if 1 {` (SPEC §2: the hint for a natural guess belongs to the rule that fires).
+`if 1 {` (docs/checks.md: the hint for a natural guess belongs to the rule that fires).
 
 The one table of such words. `unknown-command` (compiler/checks.py) and `syntax` at the
 start of a statement (compiler/parse.py) say its hint instead of a "did you mean" by
@@ -58,7 +58,7 @@ _TABLE = (
           (M.SA,), "MS176E §6.4 SA p. 71"),
     Guess(("servo", "motor"), "`MN` switches the motor (servo) on, `MF` off",
           (M.MN, M.MF), "MS176E §6.4 MN p. 69"),
-    # -- constructs of the language (SPEC §1) --
+    # -- constructs of the language (docs/language.md) --
     Guess(("if",), "write `when {n} {{ ... }}`: the block runs only if input {n} is on "
                    "(`when not {n} {{ ... }}`: off)", (M.XN, M.XF), "MS176E §5.5, §6.4 XN p. 87",
           construct=True),

@@ -1,4 +1,4 @@
-"""AST -> Program: the high-level constructs as plain macros (SPEC §1).
+"""AST -> Program: the high-level constructs as plain macros (docs/language.md).
 
 - `when` blocks become an XN/XF prefix; the block moves into a macro of its
   own, called with EM, unless it already ends its macro.
@@ -9,7 +9,7 @@
   both the block and its caller reach by a tail EM.
 - Blocks over 16 commands are chained through a tail EM when no RP needs the
   whole line; slots are allocated around raw blocks and pins.
-- Issue 8: a loop that starts its line stays in it (RP jumps to the line's
+- A loop that starts its line stays in it (RP jumps to the line's
   start); a macro that calls on only through its own blocks is inlined into a
   call with code after it; small repeats in a block that must call nothing
   are unrolled; `repeat N` past RP's range is two RPs, long periods several
@@ -69,7 +69,7 @@ def _unchained(ops: list) -> list:
     """A line with its chained parts (tail EMs 'continue' to a part) read back as one."""
     whole = list(ops)
     last = whole[-1] if whole else None
-    # a loop, not recursion: a long block is chained into thousands of parts (issue 20)
+    # a loop, not recursion: a long block is chained into thousands of parts
     while (isinstance(last, _Em) and last.role is Role.CONTINUE
            and last.target.origin is Origin.PART):
         whole += last.target.ops  # the tail EM stays: it is a call too
@@ -108,7 +108,7 @@ class _Context:
 class _Todo:
     """The statements of a line still to lower. A body that runs in a statement's place
     (a loop that runs once, an inlined callee) is pushed, not joined to the rest: a line
-    of thousands of them was a recursion and a copy per statement (issue 20)."""
+    of thousands of them was a recursion and a copy per statement."""
 
     __slots__ = ("frames", "last")
 
@@ -236,7 +236,7 @@ class _Lowerer:
         """A compiler-made macro, named after its owner and line: 'jog.when@12'. One made
         for more owners than the controller has slots cannot be stored with them: it is
         named after the user's macro alone ('jog.rest@90'), so that a chain of thousands
-        of rests does not make names thousands of owners long (issue 20)."""
+        of rests does not make names thousands of owners long."""
         root = owner.root or owner
         name = f"{(owner if owner.depth < len(SLOTS) else root).name}.{kind}@{span.line}"
         if name in self.names:  # two blocks on one line
@@ -252,7 +252,7 @@ class _Lowerer:
 
         Where a hoisted block takes the return point, the rest of the line is a
         line of its own; the rests are lowered one after another (a chain of
-        thousands recursed, issue 20), then each block with its rest as its tail,
+        thousands recursed), then each block with its rest as its tail,
         the last first: the order the macros were always made in.
         """
         todo, takers = _Todo(stmts, ctx.owner.span), []
@@ -378,7 +378,7 @@ class _Lowerer:
     def calls_on_alone(self, stmt, ctx: _Context) -> bool:
         """Whether a hoisted block, lowered alone, calls on. If not, that lowering is the
         block's; if so, it is dropped and the answer kept: a block in nested blocks that
-        call on was asked again in each lowering of theirs, 2^depth times (issue 20)."""
+        call on was asked again in each lowering of theirs, 2^depth times."""
         key = (stmt.span, ctx.leaf)
         if key in self.calling_blocks:
             return True
@@ -508,7 +508,7 @@ class _Lowerer:
 
     def part_name(self, m: _Macro) -> str:
         """'jog.part2', 'jog.part3', ...: the next free part name of a split macro."""
-        n = self.next_part.get(m.name, 2)  # not from 2 each time: thousands of parts (issue 20)
+        n = self.next_part.get(m.name, 2)  # not from 2 each time: thousands of parts
         while f"{m.name}.part{n}" in self.names:
             n += 1
         self.next_part[m.name] = n + 1
@@ -641,7 +641,7 @@ def lower(module: ast.Module, env: Env, report: Report, file: str = "") -> Progr
 def _inlinable(module: ast.Module, env: Env) -> frozenset:
     """Named macros whose body may run in a caller's place: those that call on only
     because blocks of theirs were hoisted or split. One that calls or goes to a
-    macro as written is a nested call (SPEC §2), and native EM/XN/XF/RP/TI would
+    macro as written is a nested call (docs/checks.md), and native EM/XN/XF/RP/TI would
     act on the caller's line."""
 
     def plain(body) -> bool:

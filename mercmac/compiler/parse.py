@@ -5,14 +5,14 @@ rest of the offending line is skipped and the parser carries on in one pass
 (lark's `on_error`): its stack is unwound to where a line may end, and the
 line's unbalanced braces are replayed so that blocks still nest. Checking a
 file therefore costs time in proportion to its size, however many errors it
-holds (issue 7).
+holds.
 
 The parser reads text with every line end written LF (mercmac.source.to_lf): a CR or
-CRLF ends a line as LF does, with the same line and column numbers (issue 20).
+CRLF ends a line as LF does, with the same line and column numbers.
 
 A file that parses is read by `read`, which runs grammar.lark's own tables and builds the
-AST as it goes, several times faster than lark's parse and tree (issue 20: 67-81 s to check
-a 500 KB line); lark's parser reads the others, as only it recovers from errors.
+AST as it goes, several times faster than lark's parse and tree (once 67-81 s to
+check a 500 KB line); lark's parser reads the others, as only it recovers from errors.
 """
 from __future__ import annotations
 
@@ -137,7 +137,7 @@ def tokens(text: str) -> list[tuple[str, str]]:
 
     What `mercmac fmt` rewrites. No tree is built: grammar.lark's own LALR table and
     contextual lexer (parser_tables) are run directly, about ten times faster than the
-    parse, so that formatting stays linear and quick on a 1 MB file (issue 20). One loop,
+    parse, so that formatting stays linear and quick on a 1 MB file. One loop,
     kept whole: it runs once per token.
     """
     r = _recognizer()
@@ -199,9 +199,9 @@ _LF = re.compile("\n")
 
 def read(text: str, rules: dict):
     """What `rules` make of TEXT read bottom-up by grammar.lark's automaton, as `tokens`
-    reads it: lark's parse, tree and Transformer in one pass, several times faster (issue
-    20). None where TEXT does not read cleanly (a syntax error, a raw block whose commands
-    do not read, blocks nested beyond MAX_NESTING, a NUL): `parse_partial` says why.
+    reads it: lark's parse, tree and Transformer in one pass, several times faster. None
+    where TEXT does not read cleanly (a syntax error, a raw block whose commands do not read,
+    blocks nested beyond MAX_NESTING, a NUL): `parse_partial` says why.
 
     `rules` maps each node of lark's tree to a function of the node's span and children,
     as a Transformer of lark's tree with positions gets them: the kept tokens (as Lexemes)
@@ -328,7 +328,7 @@ def _kept(rules) -> frozenset:
 
 class _Lexers(dict):
     """state -> its lexer (see `_lexer`), compiled when a text first reaches the state: a
-    file of a few lines reaches a third of them, and `check` starts sooner (issue 2)."""
+    file of a few lines reaches a third of them, and `check` starts sooner."""
 
     def __init__(self, lexers: dict):
         super().__init__()
@@ -383,7 +383,7 @@ def parse(text: str, report: Report):
 
 
 def parse_partial(text: str, report: Report) -> Parsed:
-    """Report every syntax error and return the tree of the rest (issue 10).
+    """Report every syntax error and return the tree of the rest.
 
     A broken line is left out of the tree: what it held up to the error is
     dropped with it by the builder's caller (diagnostics on broken lines are the

@@ -21,7 +21,7 @@ def rp_counts(times: int) -> tuple[int, ...] | None:
 
     One `RP n` runs the line n+1 times; `RP a,RP b` runs it (a+1)(b+1) times:
     RP b jumps back to the start, and RP a, whose counter was forgotten when
-    it fell through, starts again (SPEC §3; the manual's `RP,RP`, §3.8.6).
+    it fell through, starts again (docs/simulator.md; the manual's `RP,RP`, §3.8.6).
     """
     if times - 1 <= MAX_RP:
         return (times - 1,)
@@ -90,7 +90,8 @@ class Program:
             other.macros, other.target, other.file)
 
     def ordered(self) -> list[Macro]:
-        """Slot order with macro 0 last: the safe upload order (SPEC §4 rule 5)."""
+        """Slot order with macro 0 last: the safe upload order
+        (docs/uploader.md, "A flash, step by step")."""
         return sorted(self.macros.values(), key=lambda m: (m.slot == 0, m.slot))
 
     def md_lines(self) -> list[str]:

@@ -1,4 +1,5 @@
-"""Checks on the lowered program, where the firmware's rules really apply (SPEC §2, §3).
+"""Checks on the lowered program, where the firmware's rules really apply
+(docs/checks.md, docs/simulator.md).
 
 Run on what will be uploaded, so hoisting and splitting are checked too:
 the one return point, EM to empty slots, reachability, SC placement,

@@ -1,6 +1,6 @@
 """Reading stored macros back as a program: `decompile` (high-level source with an exact
-round trip), `describe` (the program in plain words) and its call graph (issue 12), and
-the same for a rig of several controllers (issue 18)."""
+round trip), `describe` (the program in plain words) and its call graph, and
+the same for a rig of several controllers."""
 from __future__ import annotations
 
 from mercmac.decompile.lines import read_macros

@@ -8,7 +8,8 @@ from mercmac.commands import C663, C863, MODELS, Kind, Mnemonic, lookup
 from mercmac.source import split_lines
 
 CONDITIONS = (Mnemonic.XN, Mnemonic.XF)
-CYCLE_MS = 1  # SPEC §3 Time: each executed command takes one controller cycle, 1 ms by default
+# Each executed command takes one controller cycle, 1 ms by default (docs/simulator.md, "Time").
+CYCLE_MS = 1
 # Commands that take one cycle and go on; a wait for the motor or an input, a condition that
 # may leave, a call and macro management take what the machine makes of them.
 _ONE_CYCLE = (Kind.MOTION, Kind.OUTPUT, Kind.SETTING, Kind.REPORT, Kind.REPEAT)
@@ -86,7 +87,7 @@ def every_period(ops) -> int | None:
 
 
 class Runs(NamedTuple):
-    """How often a line with RPs runs, and for how long (SPEC §3 Repeat counters, Time)."""
+    """How often a line with RPs runs, and for how long (docs/simulator.md, "Repeat counters")."""
 
     times: int  # how often the line's start runs
     ms: int | None  # the whole line, first command to last, when every command's time is known
@@ -114,7 +115,8 @@ def runs(line: Line, lines: dict[int, Line]) -> Runs | None:
 
 
 def _repeat_count(op) -> int:
-    """How often an `RP n` lets the line pass it: n + 1 (SPEC §3; a bare RP is RP65535)."""
+    """How often an `RP n` lets the line pass it: n + 1 (a bare RP is RP65535;
+    docs/simulator.md, "Repeat counters")."""
     return (lookup(Mnemonic.RP).default if op.arg is None else op.arg) + 1
 
 

@@ -1,4 +1,4 @@
-"""A stored program in plain words (issue 12): every macro the way the manual's §3.8.6
+"""A stored program in plain words: every macro the way the manual's §3.8.6
 describes its examples, grouped as a person reads a program."""
 from __future__ import annotations
 

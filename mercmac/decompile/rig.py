@@ -1,4 +1,4 @@
-"""A rig in plain words (issue 18 §5): which controller does what, each program described
+"""A rig in plain words: which controller does what, each program described
 as `describe` describes one (mercmac.decompile.prose) under its controller's name and
 address, what each wire carries (the macros that set its output and those that wait on or
 read its input, MS176E §4.5.1 "interaxis communication"), and one call graph with a

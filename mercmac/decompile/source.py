@@ -1,4 +1,4 @@
-"""Raw macros -> high-level .mcm source whose build stores the very same lines (issue 12).
+"""Raw macros -> high-level .mcm source whose build stores the very same lines.
 
 Each slot is written as richly as the round trip allows: a construct (`every`, `repeat`,
 `when` with its hoisted macros folded back, `call`, `goto`) only where compiling the
@@ -26,7 +26,7 @@ RAW, NATIVE, PLAIN, FOLD = 0, 1, 2, 3  # how richly a slot is written
 # How deep folded blocks may nest. The compiler lowers a hoisted block that calls on twice
 # (once to learn that it does), so each level doubles the work of checking a candidate:
 # a chain of conditional slots folded into one another took 17 s at 20 slots, past 300 s
-# at 24 (issue 20, item 7).
+# at 24.
 MAX_NEST = 4
 # Compiles one decompile may spend per slot. The search needs at most about seven per slot
 # (raise, again for callers, fold, unpin by halves); the examples use three or fewer. Past
@@ -414,7 +414,7 @@ def _finish(writer: _Writer, origin: str) -> str:
     from mercmac.fmt import format_text
 
     items = writer.items()
-    if origin:  # escaped: a name with a line end must not end the comment (issue 20, item 18)
+    if origin:  # escaped: a name with a line end must not end the comment
         items.insert(0, Comment(f"// Read from {printable(origin)}."))
     text = printer.module(items)
     try:  # the printer's layout is fmt's; fmt reads a `//` in a raw block's line as a comment

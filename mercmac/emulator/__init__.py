@@ -1,4 +1,4 @@
-"""The virtual controller behind `mercmac emulate` and the uploader's tests (SPEC §4).
+"""The virtual controller behind `mercmac emulate` and the uploader's tests (docs/uploader.md).
 
     virtual.py     VirtualController: the firmware's serial front end over the VM
     chain.py       Chain: several of them on one link (a daisy chain, a rig's wires live)

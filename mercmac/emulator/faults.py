@@ -1,8 +1,8 @@
 """Misbehaviour on demand: how the virtual controller may fail the way real links do.
 
-The uploader's fault tests (issue 4, item 5) and `mercmac emulate --tm-framing/--empty-slot`
-choose them; virtual.py acts on them. The answers SPEC §4 leaves open are closed sets
-(`Framing`, `EmptySlot`) whose text is what the command line takes.
+The uploader's fault tests and `mercmac emulate --tm-framing/--empty-slot` choose them;
+virtual.py acts on them. The answers the protocol leaves open (docs/uploader.md) are closed
+sets (`Framing`, `EmptySlot`) whose text is what the command line takes.
 """
 from __future__ import annotations
 
@@ -12,14 +12,15 @@ from mercmac.ops import TextEnum
 
 
 class Framing(TextEnum):
-    """How a TM listing of several macros ends its lines (SPEC §4: real controllers differ)."""
+    """How a TM listing of several macros ends its lines (real controllers differ:
+    docs/uploader.md)."""
 
     ETX_PER_LINE = "etx-per-line"  # each line a report of its own, CR LF ETX
     ONE_ETX = "one-etx"  # one report: the lines joined by CR LF, one ETX at the end
 
 
 class EmptySlot(TextEnum):
-    """What TMn of an empty slot answers (SPEC §4)."""
+    """What TMn of an empty slot answers (docs/uploader.md)."""
 
     EMPTY = "empty"  # an empty report
     BARE = "bare"  # the header alone, 'MCnnn'
@@ -27,7 +28,7 @@ class EmptySlot(TextEnum):
 
 @dataclass(slots=True)
 class Faults:
-    """Misbehaviour on demand, for the uploader's fault tests (issue 4, item 5)."""
+    """Misbehaviour on demand, for the uploader's fault tests."""
 
     drop_char: dict[int, int] = field(default_factory=dict)  # n-th MD line (1-based) -> index lost
     always_drop_slot: int | None = None  # every MD line for this slot loses a character

@@ -1,4 +1,4 @@
-"""A virtual Mercury controller that speaks SPEC §4 byte for byte.
+"""A virtual Mercury controller that speaks the serial protocol byte for byte (docs/uploader.md).
 
 `VirtualController` is the firmware's front end: address selection, line
 assembly, CR repetition, stop-on-character, the 20 ms character gap of
@@ -44,10 +44,11 @@ BITS_PER_CHAR = 10  # 8N1 on the wire: start bit, 8 data bits, stop bit (Faults.
 # a move arrives garbled, and single-character commands sent alone get through.
 MOVE_POLL_S = 0.002
 MAX_COMMANDS = mdtext.MAX_COMMANDS  # MS176E §3.8: up to 16 base commands per macro
-# A typed line runs its commands that do not wait (at most 16, one cycle each, SPEC §3
-# Time) before the next byte is read: a real controller takes microseconds for them, less
-# than one character time, so `MA10000\rTS\r` in one write runs the MA. A line that loops
-# without waiting is interrupted after that many cycles by the next character (§6.1.1).
+# A typed line runs its commands that do not wait (at most 16, one cycle each:
+# docs/simulator.md, "Time") before the next byte is read: a real controller takes
+# microseconds for them, less than one character time, so `MA10000\rTS\r` in one write runs
+# the MA. A line that loops without waiting is interrupted after that many cycles by the
+# next character (§6.1.1).
 SETTLE_CYCLES = MAX_COMMANDS + 1  # + 1: the cycle that ends the line
 # TS error codes (MS176E §6.4 TS, block 6 / block 3); the C-663 list ends at 06 too
 ERR_TIMEOUT, ERR_OVERFLOW, ERR_STORAGE = 0x01, 0x02, 0x03
@@ -377,7 +378,8 @@ class VirtualController:
             self.machine.run_until(now * 1000 + 1)
 
     def _tell(self, slots: list[int], listing: bool = False) -> None:
-        """TM/TZ answers, framed as `Faults` says (SPEC §4 leaves both open)."""
+        """TM/TZ answers, framed as `Faults` says (the protocol leaves both open:
+        docs/uploader.md)."""
         lines = protocol.lines(reports.macros(self.machine.stored_macros(), slots))
         if not lines and not listing and self.faults.empty_slot is EmptySlot.BARE:
             lines = [mdtext.tm_line(slots[0])]

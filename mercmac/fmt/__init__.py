@@ -1,4 +1,4 @@
-"""The canonical layout of a .mcm file: `mercmac fmt` (SPEC §5, issue 10).
+"""The canonical layout of a .mcm file: `mercmac fmt` (docs/cli.md).
 
 The formatter works on the token stream of grammar.lark's own parser, with the
 comments the lexer skips collected beside it, so it rewrites only the blanks
@@ -6,7 +6,7 @@ between tokens and the spelling of a few tokens, never the program:
 
 - mnemonics upper case, one space between a mnemonic or keyword and its argument
   (`MR 5000`, `when 1 and not 2`, `every 20ms`), `, ` between statements, `{ ... }`
-  with a space inside on one line, `@20` and `= 5` as SPEC §1 writes them;
+  with a space inside on one line, `@20` and `= 5` as docs/language.md writes them;
 - 4 spaces of indentation per open brace; the user's line breaks and commas stay,
   runs of blank lines are kept up to MAX_BLANK_LINES, none at the start or the end;
 - a comment stays where it stands: on a line of its own (indented with the code),
@@ -25,8 +25,8 @@ between tokens and the spelling of a few tokens, never the program:
 The spelling, blanks, indentation and comment columns are mercmac.fmt.layout's, which the
 AST printer (mercmac.fmt.printer) shares; this module reads a user's file into lines.
 A file that does not parse is not formatted: `format_text` raises FormatError.
-`load` reads a file's bytes as text only when writing that text back gives the same bytes
-(issue 20): a byte its encoding does not have is an error, never a U+FFFD written back.
+`load` reads a file's bytes as text only when writing that text back gives the same bytes:
+a byte its encoding does not have is an error, never a U+FFFD written back.
 """
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """How .mcm code is written: each token's spelling, the blanks between tokens, indentation,
-and the column of trailing comments (SPEC §5). One canonical layout for two writers:
+and the column of trailing comments (docs/cli.md). One canonical layout for two writers:
 `mercmac fmt` lays out the tokens of a user's file with it, keeping the user's line breaks
 (mercmac.fmt), and the AST printer lays out a tree, choosing them (mercmac.fmt.printer).
 """
@@ -13,7 +13,7 @@ INDENT = "    "  # per open brace
 # commented lines and the column of its comments.
 COMMENT_GAP = "   "
 # Longer code is not aligned with its neighbours: padding 10,000 short lines to the column
-# of one 1 MB line would write 10 GB (issue 20's hostile files).
+# of one 1 MB line would write 10 GB (a hostile file once did).
 ALIGN_WIDTH = 100
 
 _BLANKS = re.compile(r"[ \t\f\v]+")

@@ -3,13 +3,13 @@
 pygls cuts a document with `str.splitlines`, which also ends a line at \\f, \\v, \\x1c-\\x1e,
 U+0085, U+2028 and U+2029. Editors end lines at LF, CRLF and CR only (LSP specification,
 "Text Documents"), so an edit sent for one line landed on another and the copy drifted
-from the editor's (issue 20). A Document cuts lines with mercmac.source.LINE_END.
+from the editor's. A Document cuts lines with mercmac.source.LINE_END.
 
 Every position the server reads or sends goes through it, counting characters in the
 units the client and server agreed on (`positionEncoding`: UTF-16 unless the client
 offers UTF-8 or UTF-32), while the compiler's spans count characters (code points): an
 emoji is one character and two UTF-16 units, and a position counted in characters put a
-formatting edit's end inside the last line (issue 16). Reading: `offset_at` (an index
+formatting edit's end inside the last line. Reading: `offset_at` (an index
 into the text) and `spot` (a 1-based line and column); sending: `position` and `range_of`.
 """
 from __future__ import annotations

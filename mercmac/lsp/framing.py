@@ -3,7 +3,7 @@
 
 pygls reads a header line at a time and trusts Content-Length: a length too small or too
 big, one that is not a number or none at all put it out of step with the stream for good,
-and the server, still running, answered nothing more (issue 20). Here a frame that is
+and the server, still running, answered nothing more. Here a frame that is
 wrong is said once and skipped, and reading starts again at the next `Content-Length:`.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Rigs in the editor (issue 18 §2): a rig file (`*.rig.toml`) gets what `check RIG` reports
+"""Rigs in the editor: a rig file (`*.rig.toml`) gets what `check RIG` reports
 on it, at its positions in the rig file; a `.mcm` that a rig names as a program (a rig file
 in its folder or above) is checked with that controller's model, a `target` line that
 differs from it is reported as the rig rule model-mismatch (MR006) reports it, and it gets

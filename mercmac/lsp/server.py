@@ -41,7 +41,7 @@ _SEVERITY = {Severity.ERROR: t.DiagnosticSeverity.Error,
              Severity.WARNING: t.DiagnosticSeverity.Warning,
              Severity.INFO: t.DiagnosticSeverity.Information}
 # Diagnostics sent per document: an editor lists them all, and past a thousand it slows
-# down (a 2.5 MB file gave 288,000 of 700 bytes each, issue 20) while no one reads them.
+# down (a 2.5 MB file gave 288,000 of 700 bytes each) while no one reads them.
 MAX_DIAGNOSTICS = 1000
 SETTINGS_FILES = ("mercmac.toml", "pyproject.toml")  # mercmac.config reads these
 ADD_TARGET = f"{t.CodeActionKind.Source.value}.addTarget"

@@ -2,5 +2,5 @@
 
 rich is imported only here, and only when the output is a terminal: plain
 output (pipes, files, CI) is written without it, which keeps `mercmac check`
-fast to start (issue 2, Speed).
+fast to start.
 """

@@ -7,7 +7,7 @@ from mercmac.commands import Mnemonic as M
 from mercmac.render.console import Line, table, write_lines
 
 HEADER = ("command", "models", "argument", "what it does")
-# The constructs of the language that write these commands (SPEC §1), for a reader who
+# The constructs of the language that write these commands (docs/language.md), for a reader who
 # found the command first.
 _CONSTRUCTS = {
     M.XN: "`when n { ... }` runs a block only if input n is on",
@@ -18,7 +18,7 @@ _CONSTRUCTS = {
 }
 
 
-# What each keyword of the language means (SPEC §1): the hover and `mercmac explain when`.
+# What each keyword of the language means (docs/language.md): the hover and `mercmac explain when`.
 KEYWORD_HELP = {
     "target": "`target C-863` / `target C-663`: the controller model, for the model checks "
               "and the simulator's defaults. It lowers to nothing.",

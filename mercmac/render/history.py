@@ -13,7 +13,7 @@ COLUMNS = ("time", "port", "address", "model", "firmware", "file", "macros")
 
 def table_lines(records) -> list[Line]:
     """One row per flash, newest first as given; the controllers of one rig flash under a
-    line that names the rig (issue 18); a note when there are none."""
+    line that names the rig; a note when there are none."""
     if not records:
         return [[("no flashes recorded yet: `mercmac flash` records each verified upload", "")]]
     groups = rig_groups(records)

@@ -1,9 +1,10 @@
 """JSON text as `json.dumps(obj, indent=2)` writes it, byte for byte, faster.
 
 With an indent the standard library leaves its C encoder for a pure-Python generator; a
-simulation's JSON lists up to 10,000 entries in each of four lists (SPEC §5), and writing
-them that way took longer than simulating 1500 days (issue 19). Here each value is written
-by one recursive function into a list of strings, scalars through the C string encoder.
+simulation's JSON lists up to 10,000 entries in each of four lists
+(docs/simulator.md, "What sim writes"), and writing them that way once took longer than
+simulating 1500 days. Here each value is written by one recursive function into a list of
+strings, scalars through the C string encoder.
 tests/render/test_jsontext.py compares the two on random documents.
 """
 from __future__ import annotations

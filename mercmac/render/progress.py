@@ -6,7 +6,7 @@ from typing import TextIO
 
 from mercmac.timespec import format_clock
 
-DELAY_S = 1.0  # issue 11: only runs that take more than a second show progress
+DELAY_S = 1.0  # only runs that take more than a second show progress
 EVERY_S = 0.2  # redraw at most this often
 
 

@@ -1,4 +1,4 @@
-"""Diagnostics as text for people (plain or rich, full or concise), as JSON (SPEC §5), as
+"""Diagnostics as text for people (plain or rich, full or concise), as JSON (docs/cli.md), as
 GitHub workflow commands and as SARIF 2.1.0."""
 from __future__ import annotations
 
@@ -160,8 +160,9 @@ def write_warnings(result, stream: IO[str] | None = None) -> None:
 
 
 def to_json(diagnostics: Iterable[Diagnostic], limit: int = MAX_JSON) -> str:
-    """The `check --format json` object (SPEC §5); with more than `limit` diagnostics in a
-    file (0: no limit), the first `limit` and `"truncated": {file: count left out}`."""
+    """The `check --format json` object (docs/cli.md, "JSON output"); with more than
+    `limit` diagnostics in a file (0: no limit), the first `limit` and
+    `"truncated": {file: count left out}`."""
     import json
 
     kept, left_out = capped(diagnostics, limit)
@@ -215,7 +216,7 @@ def to_github(diagnostics: Iterable[Diagnostic], limit: int = MAX_JSON) -> str:
 
 def _github_file(file: str) -> str:
     """A path as the repository names it; a byte that is not UTF-8 as `\\xff`, the one
-    thing a workflow command cannot carry (issue 20)."""
+    thing a workflow command cannot carry."""
     return file.replace("\\", "/").translate(SURROGATES)
 
 

@@ -1,10 +1,10 @@
-"""A rig's simulation for people and programs (issue 18 §3, SPEC §6 `sim RIG`).
+"""A rig's simulation for people and programs (`sim RIG`, docs/rigs.md).
 
 The text is one timeline of every controller, merged by time, each line carrying the
 controller's name, with the wires' edges between them; then each controller's summary
 (render/sim.py draws each line and each summary). A wired input's change is the wire's
-edge, shown once as the wire, not as a button. The JSON holds one SPEC §5 object per
-controller and the wires' edges.
+edge, shown once as the wire, not as a button. The JSON holds one `sim --format json` object
+per controller (docs/simulator.md, "What sim writes") and the wires' edges.
 """
 from __future__ import annotations
 
@@ -110,8 +110,8 @@ def _summaries(result: RigRun) -> list[Line]:
 
 
 def to_json(result: RigRun) -> str:
-    """One SPEC §5 object per controller, by name, and the wires' edges (capped like §5's
-    lists, with the count left out under "truncated")."""
+    """One `sim --format json` object per controller, by name, and the wires' edges (capped like
+    its lists, with the count left out under "truncated")."""
     out = {
         "rig": result.rig.name,
         "until_ms": result.until_ms,

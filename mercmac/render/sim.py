@@ -1,4 +1,5 @@
-"""Simulation output: the timeline, the trace, the summary (text) and the JSON of SPEC §5."""
+"""Simulation output: the timeline, the trace, the summary (text) and the JSON
+(docs/simulator.md, "What sim writes")."""
 from __future__ import annotations
 
 import json
@@ -311,12 +312,12 @@ def write_scenario_passed(path: str, checked: int, stream: IO[str] | None = None
 
 
 def to_json(run: Run) -> str:
-    """SPEC §5 `sim --format json`."""
+    """`sim --format json` (docs/simulator.md, "What sim writes")."""
     return jsontext.dumps(run_json(run))  # json.dumps(..., indent=2), faster
 
 
 def run_json(run: Run) -> dict:
-    """The object of SPEC §5 `sim --format json` (a rig's has one per controller)."""
+    """The object of `sim --format json` (a rig's has one per controller)."""
     rec = run.record
     out = {
         "until_ms": run.until_ms,
@@ -339,12 +340,12 @@ def run_json(run: Run) -> dict:
     return out
 
 
-JSON_CAP = record.CAP  # SPEC §5: each JSON list keeps its first 10,000 entries
+JSON_CAP = record.CAP  # each JSON list keeps its first 10,000 entries
 
 
 def _truncated(rec: Recorder) -> dict:
-    """SPEC §5 `truncated`: when any list was cut, the counts left out of reports, outputs
-    and events (all three keys, as SPEC §5 shows them), and of the trace when it was cut."""
+    """`truncated`: when any list was cut, the counts left out of reports, outputs and
+    events (all three keys, as docs/simulator.md shows them), and of the trace when it was cut."""
     trace = rec.dropped["trace"] + max(len(rec.trace) - JSON_CAP, 0)
     counts = {key: rec.dropped[key] for key in ("reports", "outputs", "events")}
     if not (any(counts.values()) or trace):
@@ -359,7 +360,7 @@ def _source(where: ev.Where | None) -> dict:
 
 
 def _event_json(event) -> dict:
-    """One entry of SPEC §5 `events`: its time, its kind, where it came from, its details.
+    """One entry of the JSON `events`: its time, its kind, where it came from, its details.
     (One function per kind of event, found by its type: a run lists up to 10,000.)"""
     write = _EVENT_JSON.get(type(event))
     return write(event) if write else {"t_ms": ms(event.t), "kind": type(event).__name__}

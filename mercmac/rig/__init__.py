@@ -1,4 +1,4 @@
-"""Rigs (issue 18, SPEC §6): several controllers on one RS-232/USB daisy chain (MS176E
+"""Rigs (docs/rigs.md): several controllers on one RS-232/USB daisy chain (MS176E
 §3.2), their programs, the box, the joystick and the wires between their I/O lines.
 
     NAME.rig.toml --load (locate: positions)--> Rig + the file's own diagnostics

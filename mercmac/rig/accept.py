@@ -1,5 +1,5 @@
 """The one way into a rig for the commands that run it (`sim`, `describe`, `emulate --rig`,
-`flash`; SPEC §6): the rig file read, checked exactly as `check RIG` checks it, and refused
+`flash`; docs/rigs.md): the rig file read, checked exactly as `check RIG` checks it, and refused
 with `check`'s findings when it has errors, as `sim FILE` refuses a file with errors.
 
     path --read--> RigFile --check_rig (the file's settings)--> findings

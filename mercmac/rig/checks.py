@@ -1,6 +1,6 @@
 """The rig rules (MR004-MR012 in mercmac/diagnostics.py; the file's own, MR001-MR003, are
 load.py's), and `check RIG`: the rig file's findings and each program's, each program
-checked with its controller's model (issue 18, SPEC §6).
+checked with its controller's model (docs/rigs.md).
 
     rig file --load--> Rig --each program: compiler.checking with the rig's model-->
              --the rig rules over the Rig and the lowered programs--> findings per file
@@ -154,7 +154,8 @@ class Step(NamedTuple):
 def _ops(checked: Checked) -> list[Step]:
     """The commands of a lowered program from macro 0 on, each macro entered at its first
     EM (then the rest of the caller): a run's order, branches (XN/XF) taken. None for a
-    program with errors: nothing with errors is read further (STYLE.md)."""
+    program with errors: nothing with errors is read further
+    (docs/architecture.md, "One way down")."""
     compilation = checked.findings.compilation if checked.findings else None
     program = compilation.program if compilation else None
     if program is None or compilation.report.has_errors or 0 not in program.macros:
@@ -327,7 +328,7 @@ def _report_cycle(cycle: list[_Node], driver: dict[str, Wire], report: Report) -
                second_line=str(second_wait[0]), second_out=str(second.output))
 
 
-# -- sure dead-locks on an input nothing drives (SPEC §6) --------------------------------
+# -- sure dead-locks on an input nothing drives (docs/rigs.md) ------------------------
 
 class _Stop(NamedTuple):
     """Where a controller's sure path from macro 0 stops: the first WN it surely reaches

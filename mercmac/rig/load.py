@@ -1,5 +1,5 @@
 """Reading a rig file: NAME.rig.toml -> a Rig, or the diagnostics of what is wrong with the
-file itself (MR001 rig-file, MR003 rig-wire), each at its line and column (issue 18).
+file itself (MR001 rig-file, MR003 rig-wire), each at its line and column.
 
 The file is read as settings and scenarios are (mercmac.tomlfile): a regular file, at most
 mercmac.source.MAX_BYTES, UTF-8 with an optional byte-order mark. A key mercmac does not
@@ -137,9 +137,10 @@ class _Reader:
         return Controller(name, address, model.upper(), program, self.places.of(*path))
 
     def _program(self, program: str, path: tuple[str, ...], name: str) -> str | None:
-        """The program's path, when it is a .mcm file in the rig's folder or below it (SPEC
-        §6); else None, reported at the key without a word of the file (never opened: a
-        rig from elsewhere must not make `check` print /etc/passwd or ~/.aws/credentials)."""
+        """The program's path, when it is a .mcm file in the rig's folder or below it
+        (docs/rigs.md, "The rig file"); else None, reported at the key without a word of the
+        file (never opened: a rig from elsewhere must not make `check` print /etc/passwd or
+        ~/.aws/credentials)."""
         why = _why_refused(self.folder, program)
         if why is not None:
             self.report.add("rig-file", self.places.of(*path), "program", controller=name,

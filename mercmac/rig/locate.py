@@ -1,6 +1,6 @@
 """Where things stand in a rig file's text: tomllib gives values, not positions, so the
 keys, table headers and the strings of arrays (the wires) are found here, line by line,
-to give every rig diagnostic a line and column (issue 18).
+to give every rig diagnostic a line and column.
 
 A small reader of the TOML a person writes: `[a.b]` headers, `key = value` lines, arrays
 over several lines. What it cannot place (an inline table's insides) falls back to the

@@ -2,7 +2,7 @@
 C-170.PB box, the joystick's branches, and wires from output lines to input lines.
 
 A data module: it imports only the foundation, so the simulator, the emulator, the
-uploader and the language server all read the same Rig (issue 18).
+uploader and the language server all read the same Rig.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""What a person can press on a rig (SPEC §6): the buttons of the C-170.PB box on the box's
+"""What a person can press on a rig (docs/rigs.md): the buttons of the C-170.PB box on the box's
 controller, each on the input of its number, only where the box's button is connected
 (`box_buttons`) and no wire drives that input; and the joystick's inputs on a controller a
 joystick branch goes to. `sim RIG --buttons`, a rig scenario's steps and `sim RIG

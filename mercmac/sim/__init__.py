@@ -1,4 +1,4 @@
-"""The simulator application on the VM core: `mercmac sim` (SPEC §3, §5).
+"""The simulator application on the VM core: `mercmac sim` (docs/simulator.md, docs/cli.md).
 
     simulate.py    one scripted run: power on, press buttons on schedule, run to a time
     record.py      what a run keeps of the machine's events (capped lists, counts)

@@ -1,4 +1,4 @@
-"""A picture of a run (issue 11, `--plot`): position and target over time, lanes below.
+"""A picture of a run (`--plot`): position and target over time, lanes below.
 
 The lanes are the buttons held, the LEDs lit and the running macro by name. A
 long fast-forwarded stretch (a day of polling), and the idle time after the

@@ -1,6 +1,7 @@
-"""The recorder: what a simulation run keeps of the machine's events (SPEC §5 `sim`).
+"""The recorder: what a simulation run keeps of the machine's events
+(docs/simulator.md, "What sim writes").
 
-Reports and output changes are kept up to a cap (SPEC §5: 10,000 each, the rest
+Reports and output changes are kept up to a cap (10,000 each, the rest
 counted), those of fast-forwarded passes too: a skip lists what its passes
 emitted while there is room and counts the rest, so the lists and the totals
 are what plain stepping would give. Macro entries and exits, which a polling
@@ -26,7 +27,9 @@ from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
 from mercmac.vm.opcodes import Opcode
 
-CAP = 10_000  # SPEC §5: reports, output changes and events beyond this are counted, not listed
+# Reports, output changes and events beyond this are counted, not listed
+# (docs/simulator.md, "What sim writes").
+CAP = 10_000
 TIMELINE_CAP = 100_000  # timeline entries listed; the rest are counted (Recorder.unlisted)
 # events remembered to copy a skipped pass from: a pass of more could not be listed anyway
 # (two of them, stepped before the skip, filled the list), and is counted by the skip's own
@@ -144,7 +147,7 @@ class Recorder:
         self.hazards: list[ev.HazardFound] = []
         self.timeline: list = []
         self.trace: list[ev.Executed] = []
-        self.events: list = []  # every event but Executed, unfolded, for JSON (SPEC §5 `events`)
+        self.events: list = []  # every event but Executed, unfolded, for the JSON `events`
         # the latest events (skips as Blocks): a skip's passes copy the stepped one before it
         self._recent: deque = deque(maxlen=RECENT)
         self.dropped = {"reports": 0, "outputs": 0, "timeline": 0, "trace": 0, "events": 0}
@@ -206,7 +209,7 @@ class Recorder:
 
     def _skipped_events(self, skip: ev.FastForwarded) -> None:
         """The moves, arrivals, reports and macro entries of skipped passes: copies of the
-        stepped pass before the skip, listed up to the cap and counted (SPEC §5 `events`)."""
+        stepped pass before the skip, listed up to the cap and counted (the JSON `events`)."""
         end = skip.t if skip.anchor_t is None else skip.anchor_t
         template = self._pass_before(end, skip.period)
         if template is not None:

@@ -1,4 +1,4 @@
-"""All controllers of a rig on one simulated clock (issue 18 §3, SPEC §6 `sim RIG`).
+"""All controllers of a rig on one simulated clock (`sim RIG`, docs/rigs.md).
 
 Each controller is a Machine of its own (vm/machine.py) running its program; the rig
 advances them together, one instant at a time: the earliest event of any machine, of the
@@ -67,7 +67,7 @@ class RigRun:
     runs: dict[str, Run]
     edges: list[Edge]
     until_ms: int
-    edges_dropped: int = 0  # past CAP edges are counted, not listed (as SPEC §5 lists)
+    edges_dropped: int = 0  # past CAP edges are counted, not listed (as a single run counts them)
     interrupted: int = 0  # the signal that stopped the run (SIGINT: Ctrl-C), 0: none
 
     @property
@@ -100,7 +100,7 @@ class RigSim:
 
     # ------------------------------------------------------------ what happens to it
     def press(self, controller: str, presses: Iterable[Press]) -> None:
-        """Buttons of the box pressed on `controller`'s inputs (SPEC §5 `--buttons`)."""
+        """Buttons of the box pressed on `controller`'s inputs (`--buttons`, docs/cli.md)."""
         schedule(self.machines[controller], presses)
 
     def hold(self, hold: Hold) -> None:
@@ -189,7 +189,7 @@ class RigSim:
         no output and no wire will change: a controller that waits (WN/WF) on an input no
         box button drives waits for good, whether a wire or nothing drives it. When every
         controller has ended or waits for good, and one waits on a line, the rig is
-        dead-locked (SPEC §6). A wait on a box button is a wait for a person, who may
+        dead-locked (docs/rigs.md). A wait on a box button is a wait for a person, who may
         still come: never a dead-lock."""
         running = {name: m for name, m in self.machines.items() if m.running}
         stuck = {name: m for name, m in running.items() if self._stuck(name, m)}

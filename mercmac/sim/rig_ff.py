@@ -5,7 +5,7 @@ waits on a wired input cannot know when the other side will answer; so in a rig 
 machine runs instant by instant (sim/rig.py) and this module compares the joint state.
 
 A joint anchor is an instant after which every axis rests on a whole-count target or moves
-on a profile it keys relative to the time and target (issue 19), with no trigger pulse on
+on a profile it keys relative to the time and target, with no trigger pulse on
 and no JT table being made. The joint key there is every machine's state key
 (vm/statekey.py) without position, target and profile (`unshifted`), the profile and the
 trigger relative to the target, its input lines, its next command relative to now, and
@@ -223,7 +223,7 @@ def _spent(before: dict, after: dict) -> dict | None:
 def _left(visit: JointVisit) -> int | float:
     """Passes before an RP that the pass counts down would end its loop: a pass that counts
     an RP down by d from c repeats only while every jump in it still jumps (c > d; the
-    machine's rule, SPEC §3 Repeat counters)."""
+    machine's rule, docs/simulator.md, "Repeat counters")."""
     left = math.inf
     for counters, spent in zip(visit.counters, visit.spent):
         for place, d in spent.items():

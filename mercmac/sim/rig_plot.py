@@ -1,4 +1,4 @@
-"""A picture of a rig's run (issue 18 §3, `sim RIG --plot`): every axis on one clock.
+"""A picture of a rig's run (`sim RIG --plot`): every axis on one clock.
 
 On the left, one position lane (with its macro lane) per controller, the wires' levels
 and the box's buttons, all on one time axis; on the right, for a rig of two or three

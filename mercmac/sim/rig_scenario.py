@@ -1,4 +1,4 @@
-"""Scenarios for a rig (issue 18 §3): the steps and expectations of sim/scenario.py, each
+"""Scenarios for a rig: the steps and expectations of sim/scenario.py, each
 about one controller (`controller = "y"`); a step without one presses the box's buttons (the
 rig's box controller), an expectation without one is about the only controller or the box's.
 A step presses only what a person can (rig.presses). All controllers run on one clock

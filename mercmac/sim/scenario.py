@@ -1,4 +1,4 @@
-"""Scenarios: timed button steps and expectations kept in TOML (issue 3, `--scenario`).
+"""Scenarios: timed button steps and expectations kept in TOML (`--scenario`).
 
     until = "10s"
     [[step]]                     # inputs change at a time

@@ -1,4 +1,5 @@
-"""One scripted simulation: power on, press buttons on schedule, run to a time (SPEC §5 `sim`)."""
+"""One scripted simulation: power on, press buttons on schedule, run to a time
+(docs/simulator.md)."""
 from __future__ import annotations
 
 import time
@@ -12,7 +13,7 @@ from mercmac.vm.machine import Listener, Machine
 from mercmac.vm.models import Options
 from mercmac.sim.record import Recorder
 
-DEFAULT_UNTIL_MS = 10_000  # SPEC §5: --until defaults to 10s
+DEFAULT_UNTIL_MS = 10_000  # --until defaults to 10s (docs/cli.md, "Commands")
 
 
 @dataclass(slots=True)
@@ -28,7 +29,7 @@ class Run:
 
     @property
     def halted(self) -> bool:
-        """SPEC §5: the program ended before until_ms (nothing runs any more)."""
+        """The program ended before until_ms (nothing runs any more)."""
         return not self.machine.running
 
     def final(self) -> dict:
@@ -67,7 +68,7 @@ def simulate(program: Program, *, presses: Iterable[Press] = (), until_ms: int =
              model: str | None = None, cycle_ms: float = 1.0, options: Options | None = None,
              trace: bool = False, vcd: IO[str] | None = None,
              vcd_limit: int | None = None, watch=None, progress=None) -> Run:
-    """Power on at t = 0 (macro 0 starts, SPEC §3 Power-on) and run to until_ms.
+    """Power on at t = 0 (macro 0 starts, docs/simulator.md, "Power-on") and run to until_ms.
 
     A VCD stops (a valid file) before it would pass `vcd_limit` bytes; the run goes on.
     `watch` is one more listener (a plot) with `on_event`; it hears every event first.

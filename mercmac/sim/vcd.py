@@ -1,10 +1,10 @@
-"""A Value Change Dump of a run for GTKWave or Surfer, written with pyvcd (issue 3, `--vcd`).
+"""A Value Change Dump of a run for GTKWave or Surfer, written with pyvcd (`--vcd`).
 
 The writer listens to the machine's events as they happen: inputs, outputs,
 the running macro, and the position sampled every millisecond while a profile
 runs (exact at its ends). A fast-forwarded stretch is written compactly: the
 wire `vm.fast_forward` is 1 while its passes are left out, and the last pass is
-dumped in full (issue 7: a day of blinking is not a million value changes).
+dumped in full (a day of blinking is not a million value changes).
 The dump stops cleanly before it would pass `limit` bytes; `cut_at` says when.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The uploader: flash, pull and scan Mercury controllers over a serial link (SPEC §4).
+"""The uploader: flash, pull and scan Mercury controllers over a serial link (docs/uploader.md).
 
 Layers, each with its own error type that the next one up rewords
 (STYLE practice 7):

@@ -1,4 +1,5 @@
-"""Opening a port and meeting the controller there: select, stop, identify (SPEC §4 rule 2).
+"""Opening a port and meeting the controller there: select, stop, identify
+(docs/uploader.md, "The serial link").
 
 Errors of the lower layers are reworded here into `UploadError`s that say
 what to check; nothing in this module writes a macro.

@@ -93,13 +93,14 @@ class Controller:
         return self._macros(report, line).get(slot)
 
     def read_all(self) -> dict[int, str]:
-        """Every stored macro: `TM` for 1-31 in either framing of SPEC §4, then `TZ`."""
+        """Every stored macro: `TM` for 1-31 in either framing, then `TZ`."""
         first = self._ask(mdtext.tm(), lambda r: _lists_only(r, LISTED))
         stop = time.monotonic() + self.transport.timing.budget(self.transport.baud)
         macros = self._macros(first, Mnemonic.TM)
         if len(protocol.lines(first)) == 1:
             # One line then ETX: either the only macro, or the first of an
-            # ETX-per-line listing (SPEC §4). More lines follow without a pause.
+            # ETX-per-line listing (docs/uploader.md, "Reading macros back"). More lines
+            # follow without a pause.
             self._listing_rest(macros, stop)
         zero = self.read_slot(0)
         if zero:
@@ -222,7 +223,7 @@ class Controller:
 
 
 def _lists_only(report: str, slots: set[int]) -> bool:
-    """A TM/TZ answer naming only `slots`: empty, or `MCnnn` lines of those (SPEC §4)."""
+    """A TM/TZ answer naming only `slots`: empty, or `MCnnn` lines of those (docs/uploader.md)."""
     if not protocol.is_macro_report(report):
         return False
     return all(protocol.parse_macro_line(line)[0] in slots for line in protocol.lines(report))

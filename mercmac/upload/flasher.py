@@ -1,8 +1,8 @@
 """Flashing a program: back up, write what differs in the safe order, verify, report.
 
-SPEC §4 rules 3-8. The controller is identified first (session.identify);
-everything it holds is saved before the first write; each write is read back,
-written once more on a mismatch, and a failure stops the flash with a message
+The steps of docs/uploader.md, "A flash, step by step". The controller is identified
+first (session.identify); everything it holds is saved before the first write; each write
+is read back, written once more on a mismatch, and a failure stops the flash with a message
 that says what was written, what was not, and where the backup is.
 """
 from __future__ import annotations
@@ -128,7 +128,7 @@ def flash_file(port: str, path: str, *, address: int | None = 0, baud: int = DEF
                timing: Timing = Timing(), options: FlashOptions | None = None,
                target: str | None = None, force: bool = False,
                watch: Watch | None = None) -> FlashResult:
-    """Flash the .mcm file PATH to the controller at `address` on PORT (SPEC §4).
+    """Flash the .mcm file PATH to the controller at `address` on PORT (docs/uploader.md).
 
     A file without `target` (and no `target` given) is compiled again for the model
     that answers, so that it is checked against that controller; a model other than
@@ -184,7 +184,7 @@ def record(controller: Controller, identity: Identity, compiled: Compilation,
                               backup_path=result.backup, rig=rig)
     except (OSError, outfile.OutputError) as e:
         # the flash is done and verified; a history that cannot be written is no failure,
-        # but `pull` will not give this source back: the summary says so (issue 20, item 17)
+        # but `pull` will not give this source back: the summary says so
         result.unrecorded = (e.message if isinstance(e, outfile.OutputError)
                              else f"{history.folder()}: {outfile.reason(e)}")
         return None
@@ -225,7 +225,7 @@ def prepare(controller: Controller, identity: Identity, program: Program,
     every controller this way before it writes to any (mercmac.upload.rig)."""
     result = None
     try:
-        stored = controller.read_all()  # TM, TZ (SPEC §4 rule 3)
+        stored = controller.read_all()  # TM, TZ: all of it, before any write
         plan = make_plan(program, stored, erase_unused=options.erase_unused)
         result = FlashResult(identity, plan, None, options.dry_run, options.reset)
         if options.dry_run:

@@ -26,7 +26,7 @@ from mercmac.upload import backup
 
 FORMAT = 1  # the "format" of a record file; records of other formats are skipped
 # A record is a few KB (the source and its build); one over a megabyte is no record of
-# ours (issue 20, item 10). What is read at all is capped by source.read_bytes.
+# ours. What is read at all is capped by source.read_bytes.
 MAX_BYTES = 1_000_000
 # A path as the system names it: a byte that is not UTF-8 stands as U+DC80-U+DCFF (Python's
 # surrogateescape, os.fsdecode), which JSON carries as a \udcXX escape. Other text of a

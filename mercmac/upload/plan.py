@@ -1,7 +1,7 @@
 """The upload plan: which slots to write or erase, in an order safe against power cuts.
 
-SPEC §4 rules 4 and 5: write only what differs; when anything changes while
-an autostart macro exists, remove macro 0 first (`RZ`) and write it last, so
+Write only what differs (docs/uploader.md, "A flash, step by step"); when anything
+changes while an autostart macro exists, remove macro 0 first (`RZ`) and write it last, so
 a power cut mid-flash never autostarts a half-written program (MS176E §3.8.5).
 """
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 Nothing here touches a port. The transport feeds received bytes to a
 `ReportSplitter`; the controller layer frames the lines mercmac.mdtext builds
-with `select` and `command` and reads replies with the `parse_*` functions (SPEC §4).
+with `select` and `command` and reads replies with the `parse_*` functions (docs/uploader.md).
 """
 from __future__ import annotations
 
@@ -202,7 +202,8 @@ def _told(line: str) -> mdtext.Listed | None:
 
 
 def parse_macro_line(line: str) -> tuple[int, str]:
-    """Slot and contents of one `MCnnn ...` line; a bare `MCnnn` is an empty slot (SPEC §4)."""
+    """Slot and contents of one `MCnnn ...` line; a bare `MCnnn` is an empty slot
+    (docs/uploader.md)."""
     found = _told(line.strip())
     if found is None or found.slot > 31:
         raise ProtocolError("not a macro listing (expected 'MCnnn commands', "
@@ -216,7 +217,7 @@ def is_macro_report(report: str) -> bool:
 
 
 def parse_macros(report: str) -> dict[int, str]:
-    """Slots named in a TM/TZ report, empty ones left out; both framings of SPEC §4."""
+    """Slots named in a TM/TZ report, empty ones left out; both framings (docs/uploader.md)."""
     found: dict[int, str] = {}
     for line in lines(report):
         slot, text = parse_macro_line(line)
@@ -227,7 +228,7 @@ def parse_macros(report: str) -> dict[int, str]:
 
 
 def same_macro(a: str | None, b: str | None) -> bool:
-    """Whether two stored lines mean the same; None is an empty slot. SPEC §4: compare as
+    """Whether two stored lines mean the same; None is an empty slot. Compared as
     the controller may store them (MMCRun files write `EM+9` where mercmac sends `EM9`)."""
     return mdtext.normal(a) == mdtext.normal(b)
 

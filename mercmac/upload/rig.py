@@ -1,6 +1,6 @@
 """A rig over one port: flash every controller of a daisy chain at its address; pull a chain.
 
-SPEC §6, MS176E §3.2: up to 16 controllers share one RS-232/USB link and each takes only
+docs/rigs.md, MS176E §3.2: up to 16 controllers share one RS-232/USB link and each takes only
 what follows its address selection code (`\\x01` + one hex digit, §3.1.1, §3.1.3). A rig
 flash first meets every chosen controller (identify, model as the rig says, read back,
 plan, back up), and only then writes: controller after controller, each verified with macro

@@ -99,7 +99,8 @@ class Transport:
             pass
 
     def write(self, data: bytes) -> None:
-        """Send `data` in one write (SPEC §4 rule 1), waiting until it has left."""
+        """Send `data` in one write, waiting until it has left
+        (docs/uploader.md, "The serial link")."""
         try:
             written = self._serial.write(data)
             self._serial.flush()

@@ -1,4 +1,4 @@
-"""The simulator core: a bytecode VM of a Mercury controller (SPEC §3).
+"""The simulator core: a bytecode VM of a Mercury controller (docs/simulator.md).
 
     Machine(program, model=..., cycle_ms=1.0, options=Options(...), on_report=f,
             listeners=[g, ...])  # g(event) hears every vm.events record, in order

@@ -1,4 +1,5 @@
-"""The controller's clock: integer microseconds and the command cycle (SPEC §3 Time)."""
+"""The controller's clock: integer microseconds and the command cycle
+(docs/simulator.md, "Time")."""
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -1,5 +1,5 @@
-"""Fast-forward: when the passes of a polling loop repeat, and what the skipped ones emit
-(issue 3, item 5). The optimiser (vm/optimiser.py) applies these rules to a running machine.
+"""Fast-forward: when the passes of a polling loop repeat, and what the skipped ones emit.
+The optimiser (vm/optimiser.py) applies these rules to a running machine.
 
 A loop anchor is an RP jump or the entry of a macro by EM. When a loop comes
 back to its anchor with the whole machine state equal to the last visit (apart
@@ -9,17 +9,17 @@ lasts `period` and does the same, until an input changes, the run ends or the
 RP counter runs out. So they can be skipped with the clock and counter advanced
 exactly.
 
-A pass may also emit reports and output changes (issue 7, item 7: a blinking
+A pass may also emit reports and output changes (a blinking
 LED, `every 20ms { TT }`): when two passes in a row start from the same state
 and emit the same things at the same offsets (the same `shape`), the later
 passes emit them too, and a skip carries that shape so that its listeners can
 count (and list, up to their cap) exactly what plain stepping would have emitted.
 Passes that move, report a hazard or see an input change never repeat this way.
 
-Shifted passes (issue 11, item 3: a jog loop with a button held, a scan stepping
+Shifted passes (a jog loop with a button held, a scan stepping
 forever): a pass is the same pass, `delta` counts further on, when the machine
 state apart from the position and target is the same; the axis may rest on a whole
-count or, at the anchor, still run the profile a pass started (issue 19), keyed by
+count or, at the anchor, still run the profile a pass started, keyed by
 what it was planned from relative to the time and the target (Axis.relative), and
 the trigger by where it fires relative to the target (Trigger.relative). Two such passes in a row with the
 same `moved_shape` (moves, arrivals and position reports relative to the pass's
@@ -27,7 +27,7 @@ start position) and the same delta are copies; the skip (`shifted_passes`)
 stops before the next boundary: a soft limit or +-MAX_POSITION clamp, a hard
 limit switch, the end of the run, an input change, the RP counter's end, and the
 time from which the float sum of a profile's segment lengths could round to
-another arrival microsecond; and for a pass that reads TS (issue 19), the edges
+another arrival microsecond; and for a pass that reads TS, the edges
 of the reference and limit switches, whose lines its text shows (`_one_side`).
 A pass that computes with fractional positions (a move started on the way, a
 report or a trigger pulse while the axis moves: `Note.FLOATS`) repeats bit for
@@ -337,7 +337,7 @@ def compact(shape: tuple, start: int, period: int,
             passes: int) -> Iterator[Stretch | ev.OutputsChanged]:
     """A skip as a plot or a VCD draws it: the Stretch of its passes, then the output changes
     of the last pass, each inner skip drawn alike (a day of blinking is not a million
-    changes, issue 7)."""
+    changes)."""
     last = start + (passes - 1) * period
     yield Stretch(start, last, passes)
     for item in shape:

@@ -1,4 +1,4 @@
-"""The virtual controller: a bytecode VM over simulated hardware (SPEC §3).
+"""The virtual controller: a bytecode VM over simulated hardware (docs/simulator.md).
 
 One return point, per-RP counters, XN/XF exits, waits and reports as MS176E
 §3.8 and §6.4 describe them. The clock, the I/O lines and the axis are objects
@@ -251,7 +251,7 @@ class Machine:
 
     @property
     def cycle_ms(self) -> float:
-        """How long one executed command takes (SPEC §3 Time)."""
+        """How long one executed command takes (docs/simulator.md, "Time")."""
         return self.clock.cycle / 1000
 
     @property
@@ -350,7 +350,8 @@ class Machine:
         return text
 
     def iteration(self) -> int:
-        """TI: the counter of the RP that last jumped in the running macro, else 0 (SPEC §3)."""
+        """TI: the counter of the RP that last jumped in the running macro, else 0
+        (docs/simulator.md)."""
         if self.chunk is None:
             return 0
         slot = self.chunk.slot
@@ -525,7 +526,8 @@ class Machine:
         self._enter(slot, via)
 
     def _enter(self, slot: int, via: ev.Via) -> None:
-        """Enter a macro at its start; its RP counters restart (SPEC §3 Repeat counters)."""
+        """Enter a macro at its start; its RP counters restart
+        (docs/simulator.md, "Repeat counters")."""
         self.chunk, self.ip = self.chunks[slot], 0
         self.counters.pop(slot, None)
         self.last_rp.pop(slot, None)
@@ -551,7 +553,8 @@ class Machine:
         return True
 
     def _repeat(self, slot: int, ip: int, n: int) -> None:
-        """RPn: counter := n on first arrival, then counts down; jump while > 0 (SPEC §3)."""
+        """RPn: counter := n on first arrival, then counts down; jump while > 0
+        (docs/simulator.md, "Repeat counters")."""
         counters = self.counters.setdefault(slot, {})
         left = counters[ip] - 1 if ip in counters else n
         if left <= 0:

@@ -41,15 +41,16 @@ DEFAULTS = {
 class Options:
     """Bench facts the manual leaves open; each has a command-line option in `mercmac sim`."""
 
-    servo_on: bool = True  # SPEC §3: the manual's stand-alone examples never send MN
-    reference_at: int = 0  # position of the reference switch edge (SPEC §3, §4.3)
+    servo_on: bool = True  # docs/simulator.md: the manual's stand-alone examples never send MN
+    reference_at: int = 0  # position of the reference switch edge (MS176E §4.3)
     hard_limits: tuple[int, int] | None = None  # (negative, positive) limit switch positions
     address: int = 0  # DIP switches 1-4, what TB reports (§6.4 TB)
     firmware: str = "2.30"  # the version VE reports (§6.4 VE example: "Ver. 2.30")
 
 
 def model_name(name: str | None) -> str:
-    """'c-663' -> 'C-663'; None -> C-863 (SPEC §3 default); anything else is a ModelError."""
+    """'c-663' -> 'C-663'; None -> C-863 (the default: docs/simulator.md); anything else
+    is a ModelError."""
     if name is None:
         return C863
     upper = name.upper()

@@ -214,7 +214,7 @@ class Axis:
         self.target = round(self.final)
 
     def decelerate(self, t: float) -> None:
-        """AB1: decelerate with SA; the target becomes the stop point (SPEC §3)."""
+        """AB1: decelerate with SA; the target becomes the stop point (docs/simulator.md)."""
         if self.sa <= 0:
             return self.halt(t)
         self.segs = tuple(stop(t, self.position(t), self.velocity(t) * PER_S, self.sa * PER_S2))
@@ -224,7 +224,7 @@ class Axis:
         self._find_limit()
 
     def define_home(self, t: float, value: int) -> None:
-        """DH: the present position becomes `value`, target shifted alike (SPEC §3)."""
+        """DH: the present position becomes `value`, target shifted alike (docs/simulator.md)."""
         delta = value - self.position(t)
         self.shift += delta
         self.segs = tuple(s.moved(0, delta) for s in self.segs)

@@ -131,7 +131,7 @@ def _channel(n: int, s: Snapshot) -> str:
 
 def _analog(n: int, s: Snapshot) -> str:
     """TAn: 8-bit readings; a digital line reads 255 when ON. The joystick (5) rests at
-    mid-scale, 128, and reads 255 at full tilt (SPEC §3: ON above mid-scale)."""
+    mid-scale, 128, and reads 255 at full tilt (docs/simulator.md: ON above mid-scale)."""
     def value(k: int) -> int:
         if k == 5:
             return 255 if s.inputs[5] else 128
@@ -195,5 +195,5 @@ def _status_663(s: Snapshot) -> list[int]:
 
 
 def macros(stored: Mapping[int, str], slots: list[int]) -> str:
-    """TM/TZ: 'MC001 MR55555' per stored macro, one per line; '' when none (SPEC §4)."""
+    """TM/TZ: 'MC001 MR55555' per stored macro, one per line; '' when none (docs/uploader.md)."""
     return "\r\n".join(tm_line(s, stored[s]) for s in slots if s in stored)

@@ -1,4 +1,5 @@
-"""Trapezoidal motion profiles in closed form (SPEC §3 Motion; MS176E §3.4, §6.4 SV/SA).
+"""Trapezoidal motion profiles in closed form (docs/simulator.md, "Motion";
+MS176E §3.4, §6.4 SV/SA).
 
 Velocity is limited to SV and acceleration equals deceleration, SA. Times are
 microseconds and speeds counts per microsecond, so the clock stays integer.

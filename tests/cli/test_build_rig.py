@@ -1,6 +1,6 @@
-"""`build RIG.rig.toml` (issue 25 item 10): build makes one controller's MD lines for one
-output, so a rig file is refused (exit 2, SPEC §5) with its programs named, one build each;
-it was parsed as a program (29 syntax errors on the bundled rig)."""
+"""`build RIG.rig.toml`: build makes one controller's MD lines for one output, so a rig file
+is refused (exit 2: docs/cli.md, "Exit codes") with its programs named, one build each; it
+was once parsed as a program (29 syntax errors on the bundled rig)."""
 from __future__ import annotations
 
 import shutil

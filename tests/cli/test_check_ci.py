@@ -1,4 +1,4 @@
-"""`mercmac check` in CI (issue 10): output formats, rule selection, suppression comments,
+"""`mercmac check` in CI: output formats, rule selection, suppression comments,
 settings files, folders and exit codes. Tests match rule names and codes, not wording."""
 from __future__ import annotations
 
@@ -216,7 +216,7 @@ def test_nearest_settings_win_and_mercmac_toml_beats_pyproject(tmp_path):
 
 def test_settings_target_is_a_default_for_the_option(tmp_path):
     _write(tmp_path / "mercmac.toml", 'target = "C-863"\n')
-    _write(tmp_path / "a.mcm", "[MC00] DC100\n")  # DC is not on the C-863 (SPEC §2)
+    _write(tmp_path / "a.mcm", "[MC00] DC100\n")  # DC is not on the C-863 (docs/checks.md)
     assert _rules("a.mcm") == (1, ["model-unsupported"])
     assert _rules("--target", "C-663", "a.mcm") == (0, [])
 

@@ -1,5 +1,5 @@
-"""`check` of a file whose name is not UTF-8, or holds control characters (issue 20, item
-12): every output format says it without a crash; SARIF percent-encodes the name's bytes
+"""`check` of a file whose name is not UTF-8, or holds control characters:
+every output format says it without a crash; SARIF percent-encodes the name's bytes
 (RFC 3986, as SARIF §3.4.3 asks), text and concise escape it as they escape control
 characters."""
 from __future__ import annotations

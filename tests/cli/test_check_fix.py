@@ -1,4 +1,4 @@
-"""`mercmac check --fix` and `--diff` (issue 17): the safe fixes are data on the diagnostics
+"""`mercmac check --fix` and `--diff`: the safe fixes are data on the diagnostics
 (mercmac.diagnostics.Fix), applied to real files through the real CLI, in-process and as
 a process; a file is written whole, byte for byte but for its fixes, or not at all."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""`check DIR` and `fmt DIR` (issue 20, items 9 and 16): only regular .mcm files are read
+"""`check DIR` and `fmt DIR`: only regular .mcm files are read
 (`.MCM` too), a FIFO or a device below the folder is named as skipped instead of hanging
 the walk, an unreadable subfolder is named, and either makes the exit code 2."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The names of mercmac's own commands (issue 16, §6): a synonym or a misspelling gets
+"""The names of mercmac's own commands: a synonym or a misspelling gets
 "did you mean", lazily loaded commands too; a bare `mercmac` shows the help and exits 0."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""`mercmac commands [--model M] [WORD]` and `mercmac explain MNEMONIC` (issue 16, §6): the
+"""`mercmac commands [--model M] [WORD]` and `mercmac explain MNEMONIC`: the
 language is learned from the tool. Both read the one command table (mercmac.commands)."""
 from __future__ import annotations
 
@@ -149,7 +149,7 @@ def test_every_guess_points_at_commands_of_the_table_and_is_no_word_of_the_langu
 
 
 def test_explain_names_a_keyword_of_the_language():
-    """`explain when` says what the hover says of the keyword (issue 16: learn from the tool)."""
+    """`explain when` says what the hover says of the keyword (learn from the tool)."""
     from mercmac.render.commands import KEYWORD_HELP
 
     for word in ("when", "every", "goto"):

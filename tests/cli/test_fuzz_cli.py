@@ -1,4 +1,4 @@
-"""Hostile input through every command, the way a user or an attacker types it (issue 7).
+"""Hostile input through every command, the way a user or an attacker types it.
 
 Each example runs the real click command in-process with mangled sources,
 options and scenario files, and checks the three promises: no traceback (the

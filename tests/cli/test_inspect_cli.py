@@ -88,7 +88,7 @@ def test_decompile_gives_back_a_flashed_source(tmp_path, data_dir):
     assert from_port.exit_code == 0, from_port.output
     assert (tmp_path / "out.mcm").read_text() == program.read_text()
     assert "holds four-modes.mcm, flashed " in from_port.output
-    # A file is decompiled from what it holds; the history speaks of controllers (issue 16):
+    # A file is decompiled from what it holds; the history speaks of controllers:
     # tests/decompile/test_decompile_file.py
     from_file = cli("decompile", tmp_path / "raw.mcm")
     assert from_file.exit_code == 0 and from_file.stdout != program.read_text()

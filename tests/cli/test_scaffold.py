@@ -1,5 +1,5 @@
 """`mercmac examples` copies the bundled examples out; `mercmac new` writes starting programs
-that check clean (issue 26 §3). Neither replaces a file nor writes through a link."""
+that check clean. Neither replaces a file nor writes through a link."""
 from __future__ import annotations
 
 import json

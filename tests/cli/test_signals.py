@@ -1,5 +1,5 @@
 """Ctrl-C, SIGTERM and SIGHUP end every command alike, from the first instant of the program
-to its last (SPEC §5, issue 25 items 4 and 13): one line on standard error, exit 128+N, and
+to its last (docs/cli.md, "Exit codes"): one line on standard error, exit 128+N, and
 never a traceback, click's 'Aborted!', or a half-written file.
 
 Each test starts mercmac as a process through the entry point pyproject.toml declares, and

@@ -1,4 +1,4 @@
-"""Every rule of SPEC §2, table-driven: snippets and the rule names they must (not) raise."""
+"""Every rule of docs/checks.md, table-driven: snippets and the rule names they must (not) raise."""
 from __future__ import annotations
 
 import pytest
@@ -18,12 +18,12 @@ FINDS = [
     ("syntax", "macro a {\n  TP\n", None),
     ("goto-not-last", "macro a { goto b, TP }\nmacro b { TP }\n", None),
     ("goto-not-last", "autostart { when 1 { goto b, CN 1 } }\nmacro b { TP }\n", None),
-    # issue 8: a goto that ends a loop parsed fine; it is a warning, not `syntax`
+    # a goto that ends a loop parses; it is a warning, not `syntax`
     ("goto-ends-loop", "macro a { repeat 3 { MR 5, goto b } }\nmacro b { TP }\n", None),
     ("goto-ends-loop", "macro x { TP }\nautostart { repeat 3 { CN 1, TT, goto x }, CN 2 }\n", None),
     ("ti-moved", "autostart { repeat 3 { when 1 { TI } } }\n", None),
     ("repeat-zero", "macro a { repeat 0 { TP } }\n", None),
-    # issue 13: every 0ms is a busy loop, flagged like a macro that calls itself in the sim
+    # every 0ms is a busy loop, flagged like a macro that calls itself in the sim
     ("every-zero", "autostart { every 0ms { when 1 { CN 1 } } }\n", None),
     ("every-zero", "const P = 0\nautostart { every P { TP } }\n", None),
     ("syntax", "[MC01] MR 5.5\n", None),
@@ -57,7 +57,7 @@ FINDS = [
     ("argument-range", "[MC01] ZM4\n", None),
     ("argument-range", "[MC01] MA1073741824\n", None),
     ("argument-range", "[MC01] MR-1000000000\n", None),
-    # issue 8: repeat 0 is left out (repeat-zero), 40000 = 2 x 20000 is RP1,RP19999, and
+    # repeat 0 is left out (repeat-zero), 40000 = 2 x 20000 is RP1,RP19999, and
     # 70000 ms is two WAs; a prime count past 32569 and a period past 16 WAs cannot be expressed
     ("argument-range", "macro a { repeat -1 { TP } }\n", None),
     ("argument-range", "macro a { repeat 32573 { TP } }\n", None),

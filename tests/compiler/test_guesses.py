@@ -1,4 +1,4 @@
-"""Natural guesses get a hint (issue 16, §6; SPEC §2): `LED 1` says to write `CN 1`, not
+"""Natural guesses get a hint (docs/checks.md): `LED 1` says to write `CN 1`, not
 "did you mean DD?". One table (mercmac/compiler/guesses.py), used by the rule that fires."""
 from __future__ import annotations
 

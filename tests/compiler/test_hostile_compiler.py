@@ -1,4 +1,4 @@
-"""Hostile input to the compiler and `check` (issue 7): nothing lost, nothing hangs, no traceback.
+"""Hostile input to the compiler and `check`: nothing lost, nothing hangs, no traceback.
 
 Every failure is a diagnostic with a line and a column; output is safe for a terminal
 and bounded; one bad file does not stop the others.

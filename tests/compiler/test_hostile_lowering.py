@@ -1,4 +1,4 @@
-"""Lowering very long blocks (issue 20, the one-macro line of 100,000 commands): a block is
+"""Lowering very long blocks (the one-macro line of 100,000 commands): a block is
 chained into thousands of parts without recursion or quadratic copies (the times are in
 benchmarks/check_large.py)."""
 from __future__ import annotations
@@ -23,7 +23,7 @@ def test_parts_are_named_in_order_and_each_once():
 
 def test_parts_of_a_block_lowered_twice_keep_their_names():
     """A hoisted block that calls on is lowered again with a macro for the rest: its parts
-    are made again under the same names (a guard of the part numbering, issue 20)."""
+    are made again under the same names (a guard of the part numbering)."""
     ones, twos = ",".join(["MR 1"] * 35), ",".join(["MR 2"] * 19)
     text = f"autostart {{ when 1 {{ {ones} }}, TT, when 2 {{ {twos} }}, TP }}\n"
     program = compile_text(text).program

@@ -1,4 +1,4 @@
-"""Lowering: the MD strings the high-level constructs become (SPEC §1)."""
+"""Lowering: the MD strings the high-level constructs become (docs/language.md)."""
 from __future__ import annotations
 
 from helpers.compiling import compile_text
@@ -45,7 +45,7 @@ def test_rest_continues_after_a_when_that_calls():
 
 
 def test_rest_continues_after_a_repeat_that_calls():
-    # issue 8: a repeat that starts its macro now stays in line (RP jumps to the start),
+    # a repeat that starts its macro now stays in line (RP jumps to the start),
     # so the hoisting this test is about is shown after a first command
     lines = md("autostart { TP, repeat 3 { call a }, TT }\nmacro a { MR 5 }\n")
     assert lines == ["MD1,MR5", "MD2,EM1,RP2,EM3", "MD3,TT", "MD0,TP,EM2,EM3"]

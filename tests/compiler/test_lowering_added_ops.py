@@ -1,5 +1,5 @@
 """The ops a loop adds (RP, WA, EMs of moved blocks) are told from the commands the user
-wrote by what they are, not by id() (issue 17): an id() of an op the lowering dropped is
+wrote by what they are, not by id(): an id() of an op the lowering dropped is
 taken again by a later op, which the too-long-loop message then counted as added."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Lowering does bounded work on any file within the parser's limits (issue 20).
+"""Lowering does bounded work on any file within the parser's limits.
 
 Before, a hoisted block that calls on was lowered once alone (to see that it calls on)
 and again with the rest of its line as its tail, and so was every block inside it: 2^depth

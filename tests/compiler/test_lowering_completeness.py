@@ -1,6 +1,7 @@
-"""Issue 8: the compiler keeps every meaning the firmware can hold, and says so when it cannot.
+"""The compiler keeps every meaning the firmware can hold, and says so when it cannot.
 
-- Exact lowerings of the issue's cases (SPEC §1 techniques and the ones it adds).
+- Exact lowerings of the cases once refused or miscompiled (the techniques of
+  docs/language.md, "Lowering", and the ones this adds).
 - A property test on a richer generator than test_properties.py's (long bodies,
   loops that start macros, macros that call on only through hoisted blocks,
   called with code after the call, big counts and periods, repeat 0): every
@@ -140,7 +141,7 @@ def test_a_macro_that_calls_on_only_through_its_blocks_is_inlined():
     text = "macro a { TP, repeat 3 { MR 1 }, TT }\nautostart { call a, CN 1 }\n"
     lines, found = lowered(text)
     assert found == [] and lines[-1] == "MD0,TP,EM3,TT,CN1" and means_the_same(text)
-    # one that calls as written stays a nested call (SPEC §2)
+    # one that calls as written stays a nested call (docs/checks.md)
     assert "nested-call" in rules("macro a { call b, TP }\nmacro b { call c }\nmacro c { TP }\n")
 
 
@@ -153,7 +154,7 @@ def test_big_counts_and_periods_and_repeat_zero():
     assert means_the_same("autostart { repeat 40000 { MR 1 }, TT }\n", [0])
 
 
-# -- Property: the SPEC's techniques fit every generated program ---------------------
+# -- Property: the documented techniques fit every generated program --------------
 @st.composite
 def body(draw, depth: int, leaves: int, subs: int, in_loop: bool, nested: bool):
     """Statements; calls only where they keep one return point: leaves (which may start

@@ -1,7 +1,7 @@
-"""The two readings of a file give one result (issue 20, the 67-81 s `check` of a 500 KB line).
+"""The two readings of a file give one result (once a 500 KB line took 67-81 s to `check`).
 
 `parse.read` builds the AST while it reads a file that parses; lark's parser, its tree and
-the Transformer read every other file (they recover from syntax errors, issue 10). Both
+the Transformer read every other file (they recover from syntax errors). Both
 must give the same AST, spans included, and the same diagnostics; `read` may decline a
 file only where lark's reading reports something. The golden file pins what the reading
 before `read` (lark's parse, then the Transformer: commit 412d0a7) made of the examples
@@ -97,7 +97,7 @@ def mutate(text: str, rng: random.Random) -> str:
 
 
 def _diagnostics(report: Report) -> list:
-    """The syntax errors as rule and line: their wording and columns may improve (issue 16's
+    """The syntax errors as rule and line: their wording and columns may improve (the
     hints for natural guesses point at the guessed word) without the reading changing."""
     return [(d.rule.code, str(d.severity), d.span.line) for d in report.items]
 

@@ -1,4 +1,4 @@
-"""The parser's state (issue 17): the recovery of a parse under way and the named errors'
+"""The parser's state: the recovery of a parse under way and the named errors'
 keys live in an object (mercmac.compiler.parse._Parser), not in module globals that
 functions rebind or fill as they go."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 10: a broken line hides nothing on the other lines, and syntax errors say why."""
+"""A broken line hides nothing on the other lines, and syntax errors say why."""
 from __future__ import annotations
 
 import pytest

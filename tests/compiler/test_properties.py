@@ -1,7 +1,7 @@
 """Properties of the compiler on generated programs and mangled input.
 
 - Random well-formed high-level programs lower to MD strings that obey every
-  firmware limit, and run on a model of the firmware (SPEC §3) exactly as the
+  firmware limit, and run on a model of the firmware (docs/simulator.md) exactly as the
   structured program means, for every combination of held inputs.
 - Mangled input never raises: every failure is a diagnostic.
 """

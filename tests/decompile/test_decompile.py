@@ -1,4 +1,4 @@
-"""`decompile`: raw macros -> high-level source whose build stores the same lines (issue 12)."""
+"""`decompile`: raw macros -> high-level source whose build stores the same lines."""
 from __future__ import annotations
 
 from collections import Counter

@@ -1,4 +1,4 @@
-"""`decompile` of any 32-slot program does bounded work and still round-trips (issue 20, item 7).
+"""`decompile` of any 32-slot program does bounded work and still round-trips.
 
 Before, a chain of conditional slots (`[MCi] XN1,EM(i+1),MR5`) was folded into one
 `when` nested 32 deep, and the compiler lowers a nested block that calls on twice per

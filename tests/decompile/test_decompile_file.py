@@ -1,4 +1,4 @@
-"""`decompile FILE` decompiles what the file holds (issue 16, item 3.1).
+"""`decompile FILE` decompiles what the file holds.
 
 The flash history names what a *controller* holds; a file that was flashed once (the
 program itself, or a raw pull of it) is still read for its own macros, not answered with

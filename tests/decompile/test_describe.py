@@ -1,4 +1,4 @@
-"""`describe`: a stored program in plain words, and its call graph (issue 12)."""
+"""`describe`: a stored program in plain words, and its call graph."""
 from __future__ import annotations
 
 import json

@@ -1,4 +1,4 @@
-"""`describe --format markdown` reads as meant in a CommonMark renderer (issue 16, item 3.3).
+"""`describe --format markdown` reads as meant in a CommonMark renderer.
 
 The markdown is parsed with markdown-it-py (CommonMark) and its token tree compared with
 the text format: the same headings, the same items nested the same way (a loop's buttons

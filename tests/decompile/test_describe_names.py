@@ -1,5 +1,5 @@
-"""`describe` calls macros what the source calls them, as `sim` and `flash` do (issue 16,
-item 3.2): `jog (MC01)`, not `MC01 (mode_1)`; names made from what a line does only for raw
+"""`describe` calls macros what the source calls them, as `sim` and `flash` do:
+`jog (MC01)`, not `MC01 (mode_1)`; names made from what a line does only for raw
 slots, never one the source uses; on --port, the names of the recorded source."""
 from __future__ import annotations
 

@@ -1,9 +1,9 @@
-"""`describe` counts repeats as the simulator runs them (issue 16, item 3.4).
+"""`describe` counts repeats as the simulator runs them.
 
 An `RP,RP` loop is not "forever": `RP n` runs the line n+1 times (a bare RP: 65,536) and a
-second RP runs it all again, so `WA20,RP,RP` runs 4,294,967,296 times (SPEC §3 Repeat
-counters). Each line below is macro 0 of a file; `sim` runs it to its end and `describe`
-must give the same count and, where every command's time is known, the same duration.
+second RP runs it all again, so `WA20,RP,RP` runs 4,294,967,296 times (docs/simulator.md,
+"Repeat counters"). Each line below is macro 0 of a file; `sim` runs it to its end and
+`describe` must give the same count and, where every command's time is known, the same duration.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""`describe RIG` (issue 18 §5): which controller does what, what each wire carries, and the
+"""`describe RIG`: which controller does what, what each wire carries, and the
 call graph of every controller in one picture (a cluster each, wires between clusters)."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""`decompile` and `describe` under hostile names and options (issue 20, items 18 and 21).
+"""`decompile` and `describe` under hostile names and options.
 
 A file name with a line end stays inside the `// Read from` comment; `-o` naming the
 input is refused without --force; an empty `--graph` or `-o` and a port given twice are

@@ -1,4 +1,4 @@
-"""Issue 18 §4: `mercmac emulate --addresses`: a daisy chain of virtual controllers on ONE pty.
+"""`mercmac emulate --addresses`: a daisy chain of virtual controllers on ONE pty.
 
 MS176E §3.2: every controller hears every byte; only the selected one answers; a deselected
 one ignores everything but address selection codes (`\\x01` + one hex digit, §3.1.1, §3.1.3)

@@ -1,4 +1,4 @@
-"""Issue 18 §4: `mercmac emulate --rig RIG`: the rig's wires live between emulated controllers.
+"""`mercmac emulate --rig RIG`: the rig's wires live between emulated controllers.
 
 An output line of one controller drives the wired input of another as it changes (§4.5.1:
 "interaxis communication" through I/O lines), so a host sees the coordinated motion. Every
@@ -150,14 +150,14 @@ def test_a_rig_that_cannot_be_a_chain_is_refused_with_its_place(tmp_path, old, n
     path = rig_at(tmp_path, RIG.replace(old, new))
     proc = subprocess.run([sys.executable, "-m", "mercmac", "emulate", "--rig", str(path)],
                           capture_output=True, text=True, timeout=20)
-    # exit 1, as `sim FILE` with errors and `check` (SPEC §6: refused as `check` refuses it)
+    # exit 1, as `sim FILE` with errors and `check` (docs/rigs.md: refused as `check` refuses it)
     assert proc.returncode == 1 and why in proc.stderr and "Traceback" not in proc.stderr
     assert "nothing is served" in proc.stderr
 
 
 def test_a_rig_whose_program_does_not_exist_is_refused_as_check_refuses_it(tmp_path):
     """The emulated controllers start empty, but a rig `check` refuses is not served
-    (SPEC §6): one rig, one answer."""
+    (docs/rigs.md): one rig, one answer."""
     path = rig_at(tmp_path)
     (tmp_path / "x.mcm").unlink()
     result = cli("emulate", "--rig", path, catch=True)
@@ -186,7 +186,7 @@ def test_rig_and_target_together_are_refused(tmp_path):
 
 
 def test_a_rig_state_file_is_named_in_its_folder_never_a_path(tmp_path):
-    """Issue 25 item 1, defence in depth: a Rig built in the library with a path for a
+    """Defence in depth: a Rig built in the library with a path for a
     controller's name keeps no state outside the --state folder."""
     from dataclasses import replace as changed
 

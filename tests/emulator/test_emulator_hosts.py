@@ -1,4 +1,4 @@
-"""Issue 9, part 3: `mercmac emulate` as host libraries written for real controllers meet it.
+"""`mercmac emulate` as host libraries written for real controllers meet it.
 
 Every check goes byte for byte over a real pseudo-terminal, and the pipelined ones send
 their lines in ONE write, as drivers do (a query right after a move).

@@ -1,4 +1,4 @@
-"""Issue 7, items 2, 8 and 11: the emulator loses nothing, never hangs, never dies."""
+"""The emulator loses nothing, never hangs, never dies."""
 from __future__ import annotations
 
 import json

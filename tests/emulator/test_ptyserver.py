@@ -1,4 +1,4 @@
-"""The pty server's own life: closing it while a turn is still running (issue 26: after
+"""The pty server's own life: closing it while a turn is still running (once, after
 close, its thread read from a closed pty, a TypeError in the thread)."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The AST printer (issue 17): one writer of .mcm source from a tree, in `mercmac fmt`'s layout.
+"""The AST printer: one writer of .mcm source from a tree, in `mercmac fmt`'s layout.
 
 `mercmac.fmt.printer` prints a tree of `mercmac.compiler.ast`; the decompiler builds such
 trees and prints them there instead of writing text of its own. What the printer writes

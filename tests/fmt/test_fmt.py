@@ -1,4 +1,4 @@
-"""`mercmac fmt` (issue 10): one canonical layout, idempotent, never a different build."""
+"""`mercmac fmt`: one canonical layout, idempotent, never a different build."""
 from __future__ import annotations
 
 import re

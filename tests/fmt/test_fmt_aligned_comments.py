@@ -1,4 +1,4 @@
-"""`mercmac fmt` keeps trailing comments of consecutive lines in one column (issue 16, §3):
+"""`mercmac fmt` keeps trailing comments of consecutive lines in one column:
 the README's programs and every example are already in the one layout."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""`fmt RIG` (issue 18 §5): every program of a rig in the one layout; the rig file itself,
+"""`fmt RIG`: every program of a rig in the one layout; the rig file itself,
 TOML the user wrote, is left as written (and fmt says so)."""
 from __future__ import annotations
 
@@ -33,12 +33,12 @@ def test_fmt_formats_every_program_and_leaves_the_rig_file(rig):
     assert y != MESSY and "macro row {" in y and "MR 500" in y
     assert "the rig file itself is left as written" in result.stderr
     assert "1 file reformatted, 1 file left unchanged" in result.stderr
-    assert f"reformatted {rig.parent / 'y.mcm'}\n" in result.stderr  # named (issue 25 item 3)
+    assert f"reformatted {rig.parent / 'y.mcm'}\n" in result.stderr  # named
     assert "x.mcm" not in result.stderr  # left unchanged: not named
 
 
 def test_fmt_names_each_plain_file_it_rewrites(tmp_path):
-    """Issue 25 item 3: "1 file reformatted" did not say which file was written."""
+    """Once "1 file reformatted" did not say which file was written."""
     for name in ("a.mcm", "b.mcm", "c.mcm"):
         (tmp_path / name).write_text(MESSY, encoding="utf-8")
     (tmp_path / "c.mcm").write_text(cli("fmt", "-", input=MESSY).stdout, encoding="utf-8")

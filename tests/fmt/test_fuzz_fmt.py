@@ -1,4 +1,4 @@
-"""`mercmac fmt` on mutated files (issue 20): byte-exact or refused, never other bytes.
+"""`mercmac fmt` on mutated files: byte-exact or refused, never other bytes.
 
 The examples of examples/macros/ are re-encoded (UTF-8 with and without a BOM, UTF-16 and
 UTF-32 in both byte orders, Windows-1252), their line ends mixed (LF, CRLF, CR) and random

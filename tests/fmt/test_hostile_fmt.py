@@ -1,7 +1,7 @@
-"""`mercmac fmt` (and the reading `check` shares) under hostile files (issue 20): nothing
+"""`mercmac fmt` (and the reading `check` shares) under hostile files: nothing
 lost, nothing hangs, no traceback.
 
-Items 2-4, 9-10 and 21 of the issue: bytes that do not decode exactly, UTF-16/32 byte order,
+Bytes that do not decode exactly, UTF-16/32 byte order,
 an edit made while formatting, read-only files, hard links, SIGTERM, standard input's
 encoding, FIFOs, devices and files too large to read.
 """
@@ -26,7 +26,7 @@ from helpers.files import leftovers
 
 MESSY = b"macro a {mr5}\n"
 NEAT = b"macro a { MR 5 }\n"
-MAX_BYTES = 16 * 1024 * 1024  # SPEC: what mercmac reads of a .mcm file
+MAX_BYTES = 16 * 1024 * 1024  # what mercmac reads of a .mcm file (docs/cli.md, "Limits")
 # Where the mercmac under test lives: a child process started there imports the same one.
 PACKAGE_ROOT = Path(mercmac.__file__).resolve().parent.parent
 
@@ -226,7 +226,7 @@ def test_sigterm_while_writing_leaves_a_whole_file_and_no_temporary_one(messy, l
         os.link(messy, messy.parent / "b.mcm")
     done = subprocess.run([sys.executable, "-c", KILLED_WHILE_WRITING, str(nth), "fmt", str(messy)],
                           cwd=PACKAGE_ROOT, capture_output=True, text=True, timeout=60)
-    assert done.returncode == 128 + signal.SIGTERM, done.stderr  # answered as Ctrl-C (SPEC §5)
+    assert done.returncode == 128 + signal.SIGTERM, done.stderr  # answered as Ctrl-C (docs/cli.md)
     assert done.stderr.splitlines() == ["mercmac: interrupted (SIGTERM)"]
     assert leftovers(messy.parent) == [] and messy.read_bytes() == left
 

@@ -16,7 +16,7 @@ from mercmac.upload.transport import Timing
 # The answer timeout of the tests' exchanges, FAST_TIMING for the library and FAST for the
 # command line (`--timeout`): seconds of room, as the timeout is not what these tests test;
 # on a loaded machine the emulator's thread or a mercmac process may wait a second for a
-# core (issue 26: 0.3 s failed at load 10). A test that waits out a silence (nothing at an
+# core (0.3 s once failed at load 10). A test that waits out a silence (nothing at an
 # address, a silent controller) does so on a LineClock (below), in milliseconds. The settle
 # time stays short: a TM listing comes in one write of the emulator.
 FAST_TIMING = Timing(timeout=5.0, settle=0.05)

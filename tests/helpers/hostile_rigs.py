@@ -1,4 +1,4 @@
-"""Hostile rig folders for the rig fuzz tests (issue 25): random keys, types, names, paths
+"""Hostile rig folders for the rig fuzz tests: random keys, types, names, paths
 and wires, written as TOML (sometimes broken) beside programs, symlinks and a secret that
 lies outside the rig's folder and must never be read, shown or written.
 

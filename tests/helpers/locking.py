@@ -21,7 +21,7 @@ def held(path: Path):
 
     pytest-xdist gives no way to run a fixture once for all workers (its docs lock a file
     around it, as here), and `--dist loadgroup` no longer keeps a group on one worker
-    under pytest 9: two workers ran `npm ci` in one folder at once (issue 26)."""
+    under pytest 9: two workers ran `npm ci` in one folder at once."""
     with open(path, "a") as handle:
         fcntl.flock(handle, fcntl.LOCK_EX)  # blocks while another process is inside
         try:

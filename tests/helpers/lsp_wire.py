@@ -1,4 +1,4 @@
-"""A real `mercmac lsp` process fed raw bytes, for the framing tests (issue 20, item 19).
+"""A real `mercmac lsp` process fed raw bytes, for the framing tests.
 
 The client side frames and reads messages itself (LSP "Base Protocol"), so that a test can
 also write what no client library would: a wrong Content-Length, half a header, garbage.

@@ -1,5 +1,5 @@
 """The tests' reference semantics, time-free: the high-level meaning of a module, and
-the one reference interpreter of the firmware (SPEC §3), `Firmware`, that both the
+the one reference interpreter of the firmware (docs/simulator.md), `Firmware`, that both the
 lowering tests and the VM's differential test run.
 
 Both record the "effects" (every command that is not control flow) until the
@@ -86,7 +86,7 @@ def high_level_trace(module: ast.Module, env: Env, inputs: set[int], limit: int 
 
 
 class Firmware:
-    """The controller's execution of stored lines, straight from SPEC §3, without time.
+    """The controller's execution of stored lines, straight from docs/simulator.md, without time.
 
     `lines` is {slot: [(mnemonic, arg)]}; `inputs` are held for the whole run. Every
     command that is not control flow is an effect (`effects`, as text); the outputs

@@ -1,5 +1,5 @@
-"""Random framing into a real `mercmac lsp` (issue 20, item 19; the fuzz test of issue 7
-gains LSP framing).
+"""Random framing into a real `mercmac lsp` (the commands' fuzz
+tests, for LSP framing).
 
 Each example writes noise (frames with a wrong Content-Length, half headers, headers
 that are not numbers, garbage bytes, good frames among them), in writes split at random

@@ -1,5 +1,5 @@
 """`mercmac lsp` driven as an editor drives it: pytest-lsp starts it as a subprocess and
-talks LSP over stdio (issue 10). The re-checker itself is compared with `compile_source`."""
+talks LSP over stdio. The re-checker itself is compared with `compile_source`."""
 from __future__ import annotations
 
 import subprocess
@@ -124,7 +124,7 @@ async def test_completion_of_mnemonics_keywords_macros_and_consts(client: Langua
     await _diagnostics(client)
     result = await client.text_document_completion_async(t.CompletionParams(**_at(13, 17)))
     by_label = {i.label: i for i in result.items}
-    assert {"MR", "EM", "when", "repeat"} <= set(by_label)  # a statement starts (issue 16)
+    assert {"MR", "EM", "when", "repeat"} <= set(by_label)  # a statement starts
     assert "EM takes a macro number 1-31" in by_label["EM"].detail
     after_mr = await client.text_document_completion_async(t.CompletionParams(**_at(13, 20)))
     assert {i.label for i in after_mr.items} == {"SLOW", "FINE"}

@@ -1,4 +1,4 @@
-"""The language server publishes what `mercmac check` reports (issue 16, item 2).
+"""The language server publishes what `mercmac check` reports.
 
 Each example of examples/macros/ is copied into a project folder with a settings file
 (mercmac.toml or pyproject.toml's [tool.mercmac]), `// mercmac: ignore` comments on lines

@@ -1,4 +1,4 @@
-"""The language server's copy of a document stays the editor's (issue 20, items 1 and 5).
+"""The language server's copy of a document stays the editor's.
 
 An editor ends lines at LF, CRLF and CR only (LSP specification, "Text Documents"); pygls
 also ended them at \\f, \\v, \\x1c-\\x1e, U+0085, U+2028 and U+2029, so an edit sent for one

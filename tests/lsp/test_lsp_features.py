@@ -1,4 +1,4 @@
-"""What the language server offers where (issue 16, item 2), through the real `mercmac lsp`.
+"""What the language server offers where, through the real `mercmac lsp`.
 
 - Completion by context: it offered the same 135 items after `MR `, `target `, `every `,
   in a comment and at the top level.

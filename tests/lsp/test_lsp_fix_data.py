@@ -1,4 +1,4 @@
-"""The language server's quick fixes are the diagnostics' Fix data (issue 17), the edits
+"""The language server's quick fixes are the diagnostics' Fix data, the edits
 `check --fix` makes, not a "did you mean" read back from the message: the quoted name
 was searched for in the statement, and found inside the keyword before it."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""A bad frame costs that frame only (issue 20, item 19).
+"""A bad frame costs that frame only.
 
 pygls trusted Content-Length: after one too small, too big, not a number or missing, the
 server kept running and answered nothing more. Each kind of framing error is written raw

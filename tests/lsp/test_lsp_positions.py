@@ -1,5 +1,5 @@
 """Every position the language server sends or reads goes through one conversion
-(mercmac.lsp.document), in the units the client chose (issue 16, item 2).
+(mercmac.lsp.document), in the units the client chose.
 
 The compiler counts characters (code points); an editor counts UTF-16 units unless it
 offers UTF-8 or UTF-32 (`general.positionEncodings`). An emoji is one character and two

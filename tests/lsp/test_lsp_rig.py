@@ -1,4 +1,4 @@
-"""The language server and rigs (issue 18 §2), through the real `mercmac lsp`.
+"""The language server and rigs, through the real `mercmac lsp`.
 
 - A rig file (`*.rig.toml`) gets what `check RIG` reports on it, at its line and column
   in the rig file, on open and on each change.
@@ -228,7 +228,7 @@ async def test_the_rig_rules_of_a_program_stand_in_it(client: LanguageClient, ri
         "MR007": lines.index("    SC 1"), "MR010": lines.index("    WN 4")}
 
 
-# -- a broken rig is never shown clean (issue 25 item 7) ---------------------------------------
+# -- a broken rig is never shown clean -----------------------------------------------------------
 # Whatever `check RIG` says in the rig file, the editor shows at the same place; where `check`
 # cannot read the rig, one diagnostic at 1:1 says why in its words. The server used to publish
 # nothing for a rig over 16 MB, a rig naming itself as a program, a program path with a NUL and
@@ -270,7 +270,7 @@ def _shown(found: list[t.Diagnostic]) -> list[tuple]:
 @pytest.mark.asyncio
 @pytest.mark.parametrize("broken", BROKEN)
 async def test_a_broken_rig_shows_what_check_says(client: LanguageClient, rig: Path, broken):
-    """The NUL and 5,000-digit cases need `check` itself fixed (issue 25 item 11): until
+    """The NUL and 5,000-digit cases need `check` itself fixed: until
     then `check` crashes, and this test says so."""
     text = BROKEN[broken](rig.read_text(encoding="utf-8"))
     rig.write_text(text, encoding="utf-8")

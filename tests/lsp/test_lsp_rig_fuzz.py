@@ -1,4 +1,4 @@
-"""The language server and `check` agree on hostile rigs (issue 25, items 7 and "Done when"):
+"""The language server and `check` agree on hostile rigs:
 the rigs of tests/helpers/hostile_rigs.py (random keys, types, names, paths and wires,
 sometimes broken TOML), each opened in the real `mercmac lsp` and checked by `mercmac check
 --format json`: the same diagnostics at the same places, and none of them quoting the

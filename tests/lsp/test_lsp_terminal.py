@@ -1,4 +1,4 @@
-"""How `mercmac lsp` starts and stops (issue 16, items 1 and 2).
+"""How `mercmac lsp` starts and stops.
 
 - vscode-languageclient 9 with `TransportKind.stdio` runs `mercmac lsp --stdio` (pygls
   servers and most others take the flag); `mercmac lsp` refused it ("No such option").

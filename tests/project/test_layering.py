@@ -1,4 +1,4 @@
-"""The house has floors (STYLE.md "The shape of the house"): data flows one way.
+"""The house has floors (docs/architecture.md, "The floors"): data flows one way.
 
 Every import of every module under mercmac/ is read with `ast` - at the top, in
 functions, under `if` - and checked against the layers below. A second test runs
@@ -17,7 +17,7 @@ import pytest
 from helpers.paths import FOUR_MODES, PACKAGE, ROOT
 
 # Modules every layer may use: they import none of the subpackages (mercmac.ops names the Op
-# that mdtext reads and the compiler lowers to: neither imports the other for it, issue 17).
+# that mdtext reads and the compiler lowers to: neither imports the other for it).
 FOUNDATION = {"mercmac", "mercmac.__version__", "mercmac.commands", "mercmac.diagnostics",
               "mercmac.errors", "mercmac.mdtext", "mercmac.names", "mercmac.ops",
               "mercmac.outfile", "mercmac.source", "mercmac.timespec"}

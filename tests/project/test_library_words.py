@@ -1,4 +1,4 @@
-"""The application and the library meet in one place (issue 17): below mercmac/cli/ the
+"""The application and the library meet in one place: below mercmac/cli/ the
 library raises its own errors (mercmac.errors) and writes to no terminal stream; the CLI
 words the errors and owns standard output and standard error (with render/, which draws
 the text it is given a stream for).

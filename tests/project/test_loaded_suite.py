@@ -1,4 +1,4 @@
-"""tools/loaded_suite.py: the README's test command under load (issue 26) runs what CI runs,
+"""tools/loaded_suite.py: the README's test command under load runs what CI runs,
 says when stress-ng is missing, and reads pytest's counts."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Every supported Python (issue 26 §2): tools/pythons.py runs the suite on each version that
+"""Every supported Python: tools/pythons.py runs the suite on each version that
 pyenv holds, and pyproject, the README and CI name the same versions it covers."""
 from __future__ import annotations
 

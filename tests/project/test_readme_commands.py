@@ -1,5 +1,4 @@
-"""Every `mercmac ...` command the README shows runs as shown and does what its text says
-(issue 13).
+"""Every `mercmac ...` command the README shows runs as shown and does what its text says.
 
 The commands are read from the README's indented code blocks. Each runs in-process in a fresh
 folder that holds the tour's program as `prog.mcm` (taken from the README itself), the manual's
@@ -108,7 +107,7 @@ def test_the_readme_points_to_no_document_outside_the_repository():
     assert "SPEC" not in README
 
 
-# -- the messages of issue 13 that the README describes -------------------------------------
+# -- the uploader's messages that the README describes ------------------------------------
 
 def test_flash_shows_warnings_and_flashes(port, tmp_path, monkeypatch):
     """Example 4's three nested-call warnings are shown on stderr; the flash still verifies."""

@@ -1,4 +1,4 @@
-"""The suite's own layout (issue 17 §5): what tests share lives in tests/helpers/, fixtures
+"""The suite's own layout: what tests share lives in tests/helpers/, fixtures
 and hooks in conftest.py, files are found through helpers.paths (so a test file can move
 to another folder and still run), and every Hypothesis budget follows the chosen profile."""
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """What pytest-xdist workers share runs one at a time: two processes that take the lock of
 helpers.locking (the VS Code tests' `npm ci`, tests/project/test_vscode_extension.py) are
-never inside at once, however they are scheduled (issue 26)."""
+never inside at once, however they are scheduled."""
 from __future__ import annotations
 
 import subprocess

@@ -1,5 +1,5 @@
 """The suite holds when it is started with SIGINT ignored, as a background job (`pytest &`)
-and some CI runners start it (issue 16): conftest gives the test process Python's handler,
+and some CI runners start it: conftest gives the test process Python's handler,
 so every mercmac a test starts can be interrupted by its Ctrl-C tests."""
 from __future__ import annotations
 
@@ -39,7 +39,7 @@ def _ignoring_sighup() -> None:
 @pytest.mark.skipif(not hasattr(signal, "SIGHUP"), reason="needs POSIX signals")
 def test_a_hang_up_test_passes_when_the_suite_runs_under_nohup():
     """`nohup pytest` (SIGHUP ignored, inherited by every child): a mercmac a test hangs up
-    still stops as a user's would (issue 26: it flashed on and exited 0)."""
+    still stops as a user's would (once it flashed on and exited 0)."""
     test = ("tests/upload/test_flash_signals.py::"
             "test_a_signal_while_a_file_is_flashed_says_what_the_controller_holds[SIGHUP]")
     run = subprocess.run(_pytest(test), cwd=ROOT, capture_output=True, text=True, timeout=120,

@@ -1,4 +1,4 @@
-"""The package as released (issue 26 §3): the sdist and the wheel built with `python -m build`
+"""The package as released: the sdist and the wheel built with `python -m build`
 and passed by `twine check`; the wheel, installed in a fresh venv without lark, runs the
 README's commands from an empty folder with the examples `mercmac examples` fetched."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""`mercmac history` shows rigs (issue 18 §5): the controllers of one rig flash stand under
+"""`mercmac history` shows rigs: the controllers of one rig flash stand under
 a line that names the rig; JSON says for each flash which rig and controller it was."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Names from outside reach no output raw (issue 25 item 14).
+"""Names from outside reach no output raw.
 
 A program's file name is free (any character but `/` and NUL), a `--backup` folder too, and
 the flash history recalls whatever an older mercmac recorded. Each surface that shows such a

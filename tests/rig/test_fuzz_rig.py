@@ -1,5 +1,5 @@
-"""Hostile rig files through every command that reads one (issue 25, "Done when"), as the
-fuzz tests of issues 7 and 20 put hostile programs through them: random keys, types, names,
+"""Hostile rig files through every command that reads one, as the
+fuzz tests of the commands put hostile programs through them: random keys, types, names,
 paths and wires (tests/helpers/hostile_rigs.py) through `check`, `sim`, `describe`, `fmt` and
 `emulate --rig`, in-process through the real click group.
 

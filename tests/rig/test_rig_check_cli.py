@@ -1,4 +1,4 @@
-"""`mercmac check RIG.rig.toml` (issue 18): the rig file's diagnostics and each program's,
+"""`mercmac check RIG.rig.toml`: the rig file's diagnostics and each program's,
 in every output format, with --select/--ignore and check's exit codes; `explain MRnnn`."""
 from __future__ import annotations
 
@@ -100,7 +100,7 @@ def test_the_raster_programs_are_in_the_one_layout():
     assert result.exit_code == 0, result.output
 
 
-# -- issue 25: hostile rig files through every command that takes a rig ------------------------
+# -- hostile rig files through every command that takes a rig ----------------------------------
 
 SECRET = "aws_secret_access_key = hunter2\n"
 CODES = {"check": 1, "sim": 1, "describe": 1, "fmt": 2}  # fmt: a rig it cannot read is I/O

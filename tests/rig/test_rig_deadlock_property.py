@@ -1,5 +1,5 @@
 """`check`'s sure dead-lock on an input nothing drives (MR011, mercmac/rig/checks.py) against
-the rig simulator (MH008, sim/rig.py), issue 25 item 6: on random programs of two wired
+the rig simulator (MH008, sim/rig.py): on random programs of two wired
 controllers, whenever `check` says the rig dead-locks for sure, `sim` finds the dead-lock."""
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Reading a rig file (mercmac/rig/load.py, locate.py): the Rig it describes, and every
-problem of the file itself at its line and column (issue 18)."""
+problem of the file itself at its line and column."""
 from __future__ import annotations
 
 import pytest
@@ -62,11 +62,11 @@ def test_a_bom_and_crlf_or_cr_line_ends_are_read(tmp_path, end):
     ('[controllers.2x]\naddress = 0\nmodel = "C-663"\nprogram = "x.mcm"\n', "MR001", 1, 2,
      "no controller name"),
     ("name = 'r'\n", "MR001", 1, 1, "names no controller"),
-    # issue 25 item 11: more digits than int() reads, in TOML and in a wire
+    # more digits than int() reads, in TOML and in a wire
     (WIRES + controllers(x="9" * 5000), "MR001", 3, 11, "too many digits"),
     (f'wires = ["x.out{"9" * 5000} -> y.in1"]\n' + controllers(), "MR003", 1, 10, "numbered 1-4"),
     (f'wires = ["x.out1 -> y.in{"0" * 5000}"]\n' + controllers(), "MR003", 1, 10, "numbered 1-4"),
-    # issue 25 item 15: ASCII digits and names only; box_buttons twice, or without a box
+    # ASCII digits and names only; box_buttons twice, or without a box
     ('wires = ["x.out\u0661 -> y.in1"]\n' + controllers(), "MR003", 1, 10, "a wire is written"),
     ('wires = ["x.out1 -> y.in\uff11"]\n' + controllers(), "MR003", 1, 10, "a wire is written"),
     ('wires = ["x\u00e9.out1 -> y.in1"]\n' + controllers(), "MR003", 1, 10, "a wire is written"),
@@ -111,7 +111,7 @@ def test_the_readme_documents_the_keys_of_a_rig_file():
 
 @pytest.mark.parametrize("name", ["../../x", "/abs/x", "a/b", "..", "", "a b", "x\\y", "2x"])
 def test_a_rig_name_is_a_name_never_a_path(tmp_path, name):
-    """Issue 25 item 1: the name goes into file names (flash --backup DIR/, pull --rig), so
+    """The name goes into file names (flash --backup DIR/, pull --rig), so
     it is refused at the `name` key as a controller's name is, in `check` as in the reader."""
     import json
 
@@ -144,7 +144,7 @@ def test_box_buttons_are_kept_once_each_in_order(tmp_path):
 
 
 def test_a_rig_reads_without_tomllib(monkeypatch, tmp_path):
-    """Python 3.10 has no tomllib: the rig is read with tomli (issue 25 item 11), whose
+    """Python 3.10 has no tomllib: the rig is read with tomli, whose
     errors carry their place alike."""
     from helpers.python310 import without_tomllib
 
@@ -153,7 +153,7 @@ def test_a_rig_reads_without_tomllib(monkeypatch, tmp_path):
     assert _found(write_rig(tmp_path, "wires = [\n"))[0][:3] == ("MR001", 2, 1)
 
 
-# -- issue 25 item 3: a program lies in the rig's folder or below it, and ends in .mcm ----------
+# -- a program lies in the rig's folder or below it, and ends in .mcm ---------------------------
 
 SECRET = "aws_secret_access_key = hunter2\n"
 

@@ -1,4 +1,4 @@
-"""One rig, one answer (issue 25 item 5, SPEC §6): `sim`, `describe`, `emulate --rig` and
+"""One rig, one answer (docs/rigs.md): `sim`, `describe`, `emulate --rig` and
 `flash` refuse every rig that `check` finds errors in, each rule in turn, showing what
 `check` shows, and exit 1 as `sim FILE` with errors does; nothing is simulated, described,
 served or flashed. They used to run 19 of 168 such variants (addresses, models, SC in macro

@@ -1,5 +1,5 @@
 """The rig rules (MR004-MR011, mercmac/rig/checks.py): each found on a rig built for it, at
-its place, and none on the bundled raster example (issue 18, SPEC §6)."""
+its place, and none on the bundled raster example (docs/rigs.md)."""
 from __future__ import annotations
 
 import pytest
@@ -184,7 +184,7 @@ def test_a_joystick_on_both_branches_is_fine(tmp_path):
         == []
 
 
-# issue 25 item 6: x waits on in3, which no wire and no box button drives, before it raises
+# x waits on in3, which no wire and no box button drives, before it raises
 # the line y waits on: a sure dead-lock, reported at x's wait
 STUCK_X = "target C-663\nautostart { WN 3, CN 1 }\n"
 WAITING_Y = "target C-663\nautostart { WN 1, CN 2 }\n"

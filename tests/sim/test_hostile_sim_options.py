@@ -1,4 +1,4 @@
-"""`mercmac sim` refuses hostile numbers, times and scenario files with a usage error (issue 7).
+"""`mercmac sim` refuses hostile numbers, times and scenario files with a usage error.
 
 Every case: exit code 2, a message that names the option or scenario key, no traceback.
 """
@@ -107,8 +107,8 @@ def test_utf8_scenario_with_a_bom_is_read(write):
 
 
 def test_a_scenario_with_lone_cr_line_ends_is_read(write):
-    """Issue 25 item 11: one TOML reader (mercmac.tomlfile) for scenarios, settings and rigs,
-    each reading LF, CRLF and lone CR line ends alike (SPEC §5)."""
+    """One TOML reader (mercmac.tomlfile) for scenarios, settings and rigs,
+    each reading LF, CRLF and lone CR line ends alike (docs/cli.md)."""
     path = write(SCENARIO_OK.replace("\n", "\r").encode(), "s.toml")
     assert sim(write(LED), "--scenario", path).exit_code == 0
 
@@ -217,7 +217,7 @@ def test_a_fifo_or_device_as_scenario_is_refused_without_hanging(write, tmp_path
 
 
 def test_a_huge_scenario_is_refused(write):
-    """The cap of every TOML file mercmac reads (mercmac.tomlfile, issue 25 item 11)."""
+    """The cap of every TOML file mercmac reads (mercmac.tomlfile)."""
     from mercmac.source import MAX_BYTES
 
     path = write(b"", "s.toml")

@@ -1,9 +1,9 @@
-"""Nothing lost, nothing hangs: long and busy simulations, many presses, big VCDs (issue 7).
+"""Nothing lost, nothing hangs: long and busy simulations, many presses, big VCDs.
 
 Loops whose passes repeat except for what they emit are fast-forwarded, and
 the skipped passes' reports and LED changes are listed and counted exactly as
-plain stepping would (SPEC §5). Each run here has a budget of executed
-instructions, so the slow code fails fast instead of hanging the suite.
+plain stepping would (docs/simulator.md, "Fast-forward"). Each run here has a budget
+of executed instructions, so the slow code fails fast instead of hanging the suite.
 """
 from __future__ import annotations
 
@@ -136,7 +136,7 @@ def test_json_counts_the_skipped_passes():
     passes = len(every_pass(65536, 21, 1, [0], DAY_MS))
     events = out["truncated"].pop("events")
     assert out["truncated"] == {"reports": passes - 10_000, "outputs": 2 * passes - 10_000}
-    # issue 19: the events of skipped passes are counted too (a report and two output
+    # the events of skipped passes are counted too (a report and two output
     # changes a pass, the power-on entry), and the fast-forward markers past the cap
     assert 0 <= events - (3 * passes + 1 - 10_000) < 10
     assert len(out["reports"]) == len(out["outputs"]) == 10_000

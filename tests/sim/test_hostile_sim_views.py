@@ -1,4 +1,4 @@
-"""Views of a crowded run (issue 20, item 20, item 21's empty names, Slow): the text
+"""Views of a crowded run, and of empty names: the text
 timeline says exactly what it leaves out, `-vv` shows it all, and `--plot` draws
 thousands of presses as a few collections, in proportion to the run.
 """
@@ -44,7 +44,7 @@ def left_out(lines: list[str]) -> int:
 
 @pytest.fixture
 def crowded(write):
-    """6,000 short presses of a polled button over 360 s (issue 20's case)."""
+    """6,000 short presses of a polled button over 360 s (once slow to show)."""
     return [write(POLL), "--buttons", presses(6000), "--until", "360s"]
 
 

@@ -1,4 +1,4 @@
-"""The position lane inside a long shifted skip (issue 19): the band its passes sweep.
+"""The position lane inside a long shifted skip: the band its passes sweep.
 
 Passes too many to draw as copies (plot.COPIED) are drawn as an envelope: in a pixel
 column of many passes the position's min and max lie on two straight lines, one pass's

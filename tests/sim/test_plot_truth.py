@@ -1,4 +1,4 @@
-"""`sim --plot` tells the truth (issue 16, "Views that tell the truth": Plots).
+"""`sim --plot` tells the truth.
 
 The README tour's jog sets a target of 9999999 and is stopped after 300 ms: the position
 axis spans where the stage goes (0 .. 20650), and the far target is an arrow on the edge

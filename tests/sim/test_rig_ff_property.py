@@ -1,4 +1,4 @@
-"""Joint fast-forward of a rig against stepping it (issue 19): two controllers wired to each
+"""Joint fast-forward of a rig against stepping it: two controllers wired to each
 other, running random programs that move, move on the way, report while moving, set the
 trigger, and wait on each other's lines, give the same wire edges, reports, outputs,
 hazards and final state whether the rig's repeating passes are skipped or stepped; also

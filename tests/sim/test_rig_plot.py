@@ -1,4 +1,4 @@
-"""`sim RIG --plot` (issue 18 §3): a lane per axis, the wires' levels, the path picture.
+"""`sim RIG --plot`: a lane per axis, the wires' levels, the path picture.
 
 A two-axis raster runs on the rig simulator (sim/rig.py): X sweeps a line and raises
 out1, Y steps one row on in1 and raises out2, X sweeps back on in2. The figure is read

@@ -1,4 +1,4 @@
-"""A rig on one clock (issue 18 §3, sim/rig.py): wires at the same instant, the raster
+"""A rig on one clock (sim/rig.py): wires at the same instant, the raster
 example rasters, a rig built to dead-lock reports it with both macros, joint fast-forward
 gives what stepping gives, and the joystick drives its branch's controller."""
 from __future__ import annotations
@@ -102,7 +102,7 @@ def test_a_controller_that_ended_leaves_the_other_waiting_for_good(tmp_path):
             "x has ended)") in hazard.message
 
 
-# issue 25 item 6: x waits on in3, which nothing drives; y waits on x's line
+# x waits on in3, which nothing drives; y waits on x's line
 UNDRIVEN = ("autostart { WN 3, CN 1 }\n", "autostart { WN 1, CN 2 }\n",
             '"x.out1 -> y.in1", "y.out2 -> x.in2"')
 

@@ -1,4 +1,4 @@
-"""`mercmac sim RIG` (issue 18 §3, SPEC §6) through click's CliRunner and as a process:
+"""`mercmac sim RIG` (docs/rigs.md) through click's CliRunner and as a process:
 named timeline lines, JSON per controller with the wires' edges, buttons by controller,
 the joystick, --fail-on-hazard on a dead-locked rig, a VCD with a scope per controller."""
 from __future__ import annotations
@@ -63,7 +63,7 @@ def test_fail_on_hazard_exits_1_on_a_dead_locked_rig(tmp_path):
 
 
 def test_fail_on_hazard_exits_1_on_a_dead_lock_on_an_input_nothing_drives(tmp_path):
-    # issue 25 item 6: x waits on in3, which no wire and no box button drives
+    # x waits on in3, which no wire and no box button drives
     path = rig_of(tmp_path, "autostart { WN 3, CN 1 }\n", "autostart { WN 1, CN 2 }\n",
                   '"x.out1 -> y.in1", "y.out2 -> x.in2"')
     assert cli("check", str(path)).exit_code == 0  # warnings and info, no errors
@@ -174,7 +174,7 @@ def test_a_program_with_errors_is_not_simulated(tmp_path):
     assert "x.mcm:2:" in result.output and "Simulating" not in result.output
 
 
-# -- what a person can press (issue 25 item 8, SPEC §6) --------------------------------------
+# -- what a person can press (docs/rigs.md) -----------------------------------------------------
 # The raster's box is plugged into x with buttons 1 and 3 connected; x.in2 is wired from y.out2.
 
 @pytest.mark.parametrize("press, words", [

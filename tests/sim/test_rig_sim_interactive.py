@@ -1,4 +1,4 @@
-"""`sim RIG --interactive` (issue 18 §3): the live box on the rig's box controller, through a
+"""`sim RIG --interactive`: the live box on the rig's box controller, through a
 real pseudo-terminal, with every controller on the clock: X's LED 1 goes off only when Y
 answered over the wire."""
 from __future__ import annotations
@@ -33,7 +33,7 @@ def test_a_rig_without_a_box_has_no_interactive_box(tmp_path):
 
 @pytest.mark.slow
 def test_keys_of_inputs_the_box_cannot_press_do_nothing(tmp_path):
-    """Issue 25 item 8: the box on x has buttons 1 and 3 connected, and x.in2 is y's wire:
+    """The box on x has buttons 1 and 3 connected, and x.in2 is y's wire:
     keys 2 and 4 leave those lines alone (a key 2 used to mix with the wire's level)."""
     path = rig_of(tmp_path, "autostart { WA 10 }\n", "autostart { CN 1 }\n",
                   '"y.out2 -> x.in2"', 'box = "x"\nbox_buttons = [1, 3]\n')

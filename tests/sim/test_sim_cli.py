@@ -1,4 +1,4 @@
-"""`mercmac sim` through click's CliRunner and as a real subprocess (SPEC §5)."""
+"""`mercmac sim` through click's CliRunner and as a real subprocess (docs/cli.md)."""
 from __future__ import annotations
 
 import json
@@ -33,9 +33,9 @@ def test_json_truncates_at_10000_and_counts_the_rest(write):
     out = json.loads(result.output)
     passes = 60_000 // 4
     assert len(out["reports"]) == len(out["outputs"]) == 10_000
-    # SPEC §5: all three counts once any list is cut; the skipped passes' events are counted
-    # too (issue 19: a report and two LED changes a pass, the power-on entry, the markers
-    # of skips past the cap)
+    # all three counts once any list is cut (docs/simulator.md, "What sim writes"); the skipped
+    # passes' events are counted too (a report and two LED changes a pass, the power-on entry, the
+    # markers of skips past the cap)
     events = out["truncated"].pop("events")
     assert out["truncated"] == {"reports": passes - 10_000, "outputs": 2 * passes - 10_000}
     assert 0 <= events - (3 * passes + 1 - 10_000) < 10

@@ -1,6 +1,7 @@
-"""JSON `events` inside skipped passes (issue 19): the moves, arrivals, reports and macro
+"""JSON `events` inside skipped passes: the moves, arrivals, reports and macro
 entries of fast-forwarded passes are listed as plain stepping lists them while there is room
-(SPEC §5: 10,000), then counted in `truncated`; the `fast-forward` event stays as a marker."""
+(10,000: docs/simulator.md, "What sim writes"), then counted in `truncated`; the `fast-forward`
+event stays as a marker."""
 from __future__ import annotations
 
 import json
@@ -59,7 +60,7 @@ def test_skipped_passes_list_the_events_stepping_lists(name):
 
 @pytest.mark.parametrize("name", LOOPS)
 def test_past_the_cap_the_events_of_skipped_passes_are_counted(name):
-    # the cap at 1/20 of SPEC §5's 10,000 and runs 1/20 as long: the same crossing of the cap
+    # the cap at 1/20 of the real 10,000 and runs 1/20 as long: the same crossing of the cap
     # in every loop (the real cap is crossed by the CLI tests below), in seconds, not minutes
     program = program_of(LOOPS[name])
     until_ms = 150_000

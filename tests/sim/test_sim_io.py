@@ -1,4 +1,4 @@
-"""`mercmac sim`'s exact inputs and outputs (issue 11 item 4): presses, JSON events, scenarios, exits."""
+"""`mercmac sim`'s exact inputs and outputs: presses, JSON events, scenarios, exits."""
 from __future__ import annotations
 
 import json
@@ -43,7 +43,7 @@ def test_a_merged_press_is_released_once_at_its_last_release(write):
 def test_json_events_carry_time_kind_macro_slot_and_line(write):
     out = run_json(write("[MC00] CN1,MA500,WS0,TP\n"), "--buttons", "2@1ms-2ms", "--until", "1s")
     assert list(out)[:8] == ["until_ms", "halted", "ended_ms", "final", "reports", "outputs",
-                             "hazards", "events"]  # SPEC §5: the old keys stay as they were
+                             "hazards", "events"]  # the old keys stay as they were
     kinds = [e["kind"] for e in out["events"]]
     for kind in ("macro-enter", "output", "press", "release", "move", "arrive", "report",
                  "macro-exit", "program-end"):

@@ -1,4 +1,4 @@
-"""`mercmac sim --plot` (issue 11, item 2): the files are made and hold the lanes.
+"""`mercmac sim --plot`: the files are made and hold the lanes.
 
 Position and target over time, with lanes for the buttons, the LEDs and the
 running macro; long fast-forwarded stretches drawn compressed and marked. The

@@ -1,4 +1,4 @@
-"""The text timeline of `mercmac sim`: a story by default, more with -v and -vv (issue 11)."""
+"""The text timeline of `mercmac sim`: a story by default, more with -v and -vv."""
 from __future__ import annotations
 
 import re

@@ -1,4 +1,4 @@
-"""The position signal of a VCD inside a shifted skip (issue 19): where the skipped passes
+"""The position signal of a VCD inside a shifted skip: where the skipped passes
 start, and the last pass's moves sampled as plain stepping samples them."""
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """The flasher's events are one closed set (flasher.EventKind) that render.upload matches
-on (issue 17): a real flash over a pty tells only those, and a log shows each of them."""
+on: a real flash over a pty tells only those, and a log shows each of them."""
 from __future__ import annotations
 
 import io

@@ -1,4 +1,4 @@
-"""A flash that leaves macros the file does not define says how to remove them (issue 16, §6):
+"""A flash that leaves macros the file does not define says how to remove them:
 against the emulator on a real pseudo-terminal, through the real CLI."""
 from __future__ import annotations
 

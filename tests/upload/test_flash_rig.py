@@ -1,4 +1,4 @@
-"""`flash RIG` (issue 18 §4): every controller of a rig over one pty, against an emulated
+"""`flash RIG`: every controller of a rig over one pty, against an emulated
 daisy chain (mercmac.emulator.chain) — the library, the CLI in-process and as a process."""
 from __future__ import annotations
 
@@ -243,7 +243,7 @@ def test_flash_then_pull_against_emulate_addresses_as_processes(rig, tmp_path, d
     assert (out / "raster.rig.toml").is_file()
 
 
-# -- issue 25: names are never paths; one rule for an unwritable backup folder ------------------
+# -- names are never paths; one rule for an unwritable backup folder ----------------------------
 
 def _nothing_sent(log: io.StringIO) -> bool:
     return not re.search(r"^\s*[\d.]+ -> ", log.getvalue(), re.M)

@@ -1,4 +1,4 @@
-"""SIGTERM and SIGHUP while `flash` writes are answered as Ctrl-C is (SPEC §5, issue 25 item 4):
+"""SIGTERM and SIGHUP while `flash` writes are answered as Ctrl-C is (docs/cli.md):
 what each controller holds, where its backup is, exit 128+N; and the backup puts it back.
 
 Each flash is a real process against the virtual controller (or chain) on a pty; the signal

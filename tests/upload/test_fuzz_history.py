@@ -1,4 +1,4 @@
-"""Hostile flash history records through `history`, `pull` and `decompile --port` (issue 20).
+"""Hostile flash history records through `history`, `pull` and `decompile --port`.
 
 Each example fills a fresh `MERCMAC_DATA_DIR/history` with one record a real flash wrote,
 records that are fine although unusual (other UTC offsets, no model, no backup, odd file

@@ -1,4 +1,4 @@
-"""The flash history's rig fields (issue 18): a rig flash names the rig and the controller;
+"""The flash history's rig fields: a rig flash names the rig and the controller;
 a single flash's record, and an older mercmac's, has none and stays readable."""
 from __future__ import annotations
 

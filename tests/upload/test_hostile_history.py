@@ -1,4 +1,4 @@
-"""The flash history under hostile records (issue 20, items 6, 9-11, 17, 18).
+"""The flash history under hostile records.
 
 A record that is no record (wrong types, nulls, a time without offset, deep nesting, a
 FIFO, a link to /dev/zero, too big) is skipped with one warning naming it, and the others

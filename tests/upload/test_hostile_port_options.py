@@ -1,4 +1,4 @@
-"""Ports and counts said right (issue 20, item 21): `-p A -p B` is refused, a file that is
+"""Ports and counts said right: `-p A -p B` is refused, a file that is
 no serial port is named as such (a FIFO is never waited on), and one macro is "1 macro"."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Issue 7, items 4, 5 and 12: nothing hangs, nothing is lost, no traceback, against peers
+"""Nothing hangs, nothing is lost, no traceback, against peers
 that misbehave on purpose — a nan timeout, an endless TM listing, a flood of junk, a TCP
 peer that hangs up mid-flash, and Ctrl-C at the worst moments."""
 from __future__ import annotations
@@ -25,7 +25,7 @@ VERSION = b"(c)2009 Physik Instrumente(PI) Karlsruhe, C-863, Ver. 2.30, 2009-21-
 STATUS = b"S:00 00 00 00 00 00" + END
 BOUND_S = 10  # every hostile run below must be over well before this
 # the answer timeout where an endless reply is tested, not the timeout: room for a loaded
-# machine to run the peer's thread (0.3 s failed, issue 26), within BOUND_S with the budget
+# machine to run the peer's thread (0.3 s once failed), within BOUND_S with the budget
 PEER_TIMEOUT = ("--timeout", "2")
 
 

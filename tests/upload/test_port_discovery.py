@@ -1,4 +1,4 @@
-"""Issue 13: the uploader as esptool and mpremote users expect it.
+"""The uploader as esptool and mpremote users expect it.
 
 PORT and --address may be left out, a swapped `flash FILE PORT` is recognised,
 `scan` shows its progress, the flash bar a rate and the time left, a dry run

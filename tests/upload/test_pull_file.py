@@ -1,5 +1,5 @@
 """upload.survey.pull_file: the controller half of `mercmac pull` and `decompile --port`,
-finding the address as flash_file does (issue 17). The virtual controller on a real pty."""
+finding the address as flash_file does. The virtual controller on a real pty."""
 from __future__ import annotations
 
 import pytest

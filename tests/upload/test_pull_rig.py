@@ -1,4 +1,4 @@
-"""`pull --rig DIR` and `decompile --port --rig DIR` (issue 18 §4): a scanned chain becomes a
+"""`pull --rig DIR` and `decompile --port --rig DIR`: a scanned chain becomes a
 rig folder, names given back by the flash history, against an emulated chain on a pty."""
 from __future__ import annotations
 
@@ -101,7 +101,7 @@ def test_pull_rig_as_a_process(rig, tmp_path, data_dir):
     assert (out / "y.mcm").read_text() == (rig.parent / "y.mcm").read_text()
 
 
-# -- issue 25: names from the history are never paths; DIR's files are not replaced silently -----
+# -- names from the history are never paths; DIR's files are not replaced silently ---------------
 
 def _poison(data_dir: Path, rig_name: str, controller: str) -> None:
     """Every history record says the rig and the controller are called so."""
@@ -212,7 +212,7 @@ def test_a_read_only_folder_is_refused_by_its_mode_even_as_root(tmp_path, data_d
     assert list(ro.iterdir()) == []
 
 
-# -- issue 25 item 15: two controllers at one address -------------------------------------------
+# -- two controllers at one address -------------------------------------------------------------
 
 @contextmanager
 def shared_address(macros=RAW):
@@ -266,7 +266,7 @@ def test_a_history_name_like_another_address_does_not_merge_two_controllers(tmp_
     assert cli("check", out / "r.rig.toml").exit_code == 0
 
 
-# -- issue 26: a --timeout given is the wait at each address too ------------------------------
+# -- a --timeout given is the wait at each address too ----------------------------------------
 
 @pytest.mark.parametrize("given, search", [((), 0.3), (("--timeout", "2"), 2.0),
                                             (("--timeout", "0.1"), 0.1)])

@@ -1,5 +1,6 @@
-"""Faults of issue 4, item 5, each over a real pseudo-terminal: the uploader stops cleanly,
-says why, writes nothing before the backup, and never leaves a half-written program autostarting."""
+"""Faults of the link and the controller (mercmac/emulator/faults.py), each over a real
+pseudo-terminal: the uploader stops cleanly, says why, writes nothing before the backup, and
+never leaves a half-written program autostarting."""
 from __future__ import annotations
 
 import os

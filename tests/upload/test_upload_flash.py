@@ -129,7 +129,8 @@ def test_byte_goals_of_the_benchmark(capsys):
 
 
 def test_a_socket_url_works_like_a_port(tmp_path):
-    """PORT may be any pyserial URL (SPEC §5): here socket:// to a TCP bridge of the emulator."""
+    """PORT may be any pyserial URL (docs/cli.md, "Commands"): here socket:// to a TCP
+    bridge of the emulator."""
     import select
     import socket
     import threading

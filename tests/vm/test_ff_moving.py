@@ -1,4 +1,4 @@
-"""Fast-forward of passes that move on the way (issue 19): a profile still running when the
+"""Fast-forward of passes that move on the way: a profile still running when the
 loop comes round, moves started while the axis moves, and reports (TP, TD, TE, TV, TS) taken
 during a move. Such passes repeat shifted, bit for bit, while their positions and times stay
 within one power of two (fastforward._same_binade); the skips must give exactly what plain
@@ -24,7 +24,8 @@ from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
 from mercmac.vm.models import Options
 
-# the issue's two loops: reports between short moves, and a long body moving on the way
+# the loops (i) and (j) of benchmarks/sim_speed.py: reports between short moves, and a long
+# body moving on the way
 BETWEEN_MOVES = ("macro m {\n  TT, MR 1, when 4 { goto fin }, goto m\n}\n"
                  "macro fin {\n  TP\n}\nautostart { goto m }\n")
 LONG_BODY = ("autostart {\n  every 30ms { "

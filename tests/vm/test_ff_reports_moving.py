@@ -1,4 +1,4 @@
-"""Fast-forward of shifted passes that read the switches (issue 19): TS shows the reference
+"""Fast-forward of shifted passes that read the switches: TS shows the reference
 and limit lines, which change only where a pass crosses the reference edge or a limit
 switch, so those crossings end a skip (like soft limits) and the passes between are
 skipped, exactly as plain stepping runs them."""

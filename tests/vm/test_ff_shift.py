@@ -1,5 +1,5 @@
 """Shifted fast-forward: passes that differ only by a constant shift of position and target
-(issue 11, item 3) are skipped up to the next boundary, exactly as plain stepping runs them."""
+are skipped up to the next boundary, exactly as plain stepping runs them."""
 from __future__ import annotations
 
 import io

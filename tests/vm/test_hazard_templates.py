@@ -1,4 +1,4 @@
-"""Hazard messages are templates of their rule, as the checks' are (issue 17): the machine
+"""Hazard messages are templates of their rule, as the checks' are: the machine
 reports a hazard with values, never wording, and vm/hazards.py holds every sentence."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Closed sets are types (issue 17): what started a move, how it ended, how a macro was entered
+"""Closed sets are types: what started a move, how it ended, how a macro was entered
 and left, what a timeline fold is and how the emulator misbehaves are enums declared beside
 the code that produces them; their text is what the JSON and the command line say."""
 from __future__ import annotations

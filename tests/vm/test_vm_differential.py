@@ -1,5 +1,5 @@
 """The VM against the tests' reference interpreter (`semantics.Firmware`, written
-straight from SPEC §3, time-free), the one the lowering tests use too.
+straight from docs/simulator.md, time-free), the one the lowering tests use too.
 
 Random programs of calls, repeats, conditions, outputs and reports run on both;
 the order of reports and of output patterns, and whether the program ends,
@@ -58,6 +58,7 @@ def test_the_reference_itself_follows_the_manual_examples():
     counted = Firmware({0: [("TI", None), ("RP", 2)]}, set())
     assert counted.run(BUDGET) and counted.reports == ["X:+0000000000", "X:+0000000002",
                                                        "X:+0000000001"]
-    # a bare RP is 65535 (SPEC §3); XN ends the macro when its input is off
+    # a bare RP is 65535 (docs/simulator.md, "Repeat counters"); XN ends the macro when its
+    # input is off
     bare = Firmware({0: [("TB", None), ("XN", 1), ("RP", None)]}, set())
     assert bare.run(BUDGET) and bare.effects == ["TB"]

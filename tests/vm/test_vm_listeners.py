@@ -1,4 +1,4 @@
-"""The machine tells a list of listeners (issue 17): a plot, a VCD and the recorder each hear
+"""The machine tells a list of listeners: a plot, a VCD and the recorder each hear
 every event from the machine itself, in order, none of them passing events on to the next."""
 from __future__ import annotations
 

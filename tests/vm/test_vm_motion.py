@@ -1,4 +1,5 @@
-"""Motion timing against the closed-form trapezoid and triangle, and the axis's rules (SPEC §3)."""
+"""Motion timing against the closed-form trapezoid and triangle, and the axis's rules
+(docs/simulator.md)."""
 from __future__ import annotations
 
 import math

@@ -1,4 +1,4 @@
-"""Issue 17, section 1: the interpreter and its fast-forward optimiser are two things; the
+"""The interpreter and its fast-forward optimiser are two things; the
 state key comes from field marks; shapes are typed records walked by fastforward; the
 modes, the wait, the return point and a hazard's place are types."""
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""SPEC §3, one bullet at a time: the VM runs lowered macros as the firmware does."""
+"""The rules of docs/simulator.md, one at a time: the VM runs lowered macros as the
+firmware does."""
 from __future__ import annotations
 
 import pytest

@@ -1,4 +1,4 @@
-"""Reports read a snapshot of the machine, not the machine (issue 17): vm/reports.py formats
+"""Reports read a snapshot of the machine, not the machine: vm/reports.py formats
 from `Machine.snapshot()`, a record of values at one instant, and from nothing else."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""How a snapshot is taken (issue 17): `Machine.snapshot()` runs once per report, so it builds
+"""How a snapshot is taken: `Machine.snapshot()` runs once per report, so it builds
 the Snapshot by position and shares the stored macros' lines until the code changes. These
 hold each field to what the machine says by name, and the shared lines to every change of
 code (load, define, RM, RZ, RMALL)."""

@@ -1,4 +1,4 @@
-"""Issue 9: the VM's narrow surface, fast-forward's state keys, enums, and flashing a file."""
+"""The VM's narrow surface, fast-forward's state keys, enums, and flashing a file."""
 from __future__ import annotations
 
 import ast
