@@ -7,9 +7,9 @@ except address selection codes" while its macros keep running (§3.2). Every con
 machine runs on wall time whether it is selected or not.
 
 Wires join an output line of one controller to an input line of another ("interaxis
-communication", §4.5.1): the machines advance together from event to event, and after each
-step every wired input takes its driving output's level at that instant, so a level change
-is seen by the other controller at the time it happens, not a server tick later.
+communication", §4.5.1): the wired machines advance together by the instant rule of
+vm/wiring.py, the one `sim RIG` follows, so a level change is seen by the other controller
+at the microsecond it happens, as the simulator shows it, not a server tick later.
 """
 from __future__ import annotations
 
@@ -21,8 +21,23 @@ from mercmac import outfile
 from mercmac.emulator.faults import Faults
 from mercmac.emulator.virtual import StateError, VirtualController
 from mercmac.rig.model import Rig
+from mercmac.vm.wiring import Wired
 
-EPSILON_MS = 0.001  # 1 us, the VM's unit: run *through* an event, not just up to it
+US_PER_S = 1_000_000  # the server's clock is in seconds, the VM's in whole us
+
+
+@dataclass(frozen=True, slots=True)
+class End:
+    """One end of a wire as the wired clock keys it: a controller's address, a line."""
+
+    controller: int
+    number: int
+
+
+@dataclass(frozen=True, slots=True)
+class Link:
+    source: End
+    target: End
 
 
 @dataclass(frozen=True, slots=True)
@@ -34,9 +49,9 @@ class Wiring:
     target: VirtualController
     input: int
 
-    def level(self) -> bool:
-        """The driving output's level now (bit 0 = output 1, §6.4 CP)."""
-        return bool(self.source.machine.outputs_pattern() >> (self.output - 1) & 1)
+    def link(self) -> Link:
+        """This wire as the wired clock keys it: by address (vm/wiring.py)."""
+        return Link(End(self.source.address, self.output), End(self.target.address, self.input))
 
 
 class Chain:
@@ -51,6 +66,8 @@ class Chain:
         self.wires = tuple(wires)
         self.names = dict(names or {})  # address -> the rig's name, for the log
         self.parts: list[tuple[int, bytes]] = []  # the last `take`, by who sent it
+        self._wired = Wired({c.address: c.machine for c in controllers},
+                            [w.link() for w in self.wires], guard=self._guarded)
         self._carry()  # outputs are off at power-on: wired inputs start low
 
     @property
@@ -88,26 +105,18 @@ class Chain:
         return b"".join(data for _, data in self.parts)
 
     def _advance(self, now: float) -> None:
-        """Run the wired machines together from event to event up to `now`, carrying the
-        output levels across after each, so a wired input changes when its output does."""
-        if not self.wires:
-            return  # nothing joins them: each runs alone in its own `tick`
-        end_ms, done = now * 1000, -1.0
-        while (t := min(c.machine.next_event_ms() for c in self.controllers)) < end_ms:
-            done = max(t, done) + EPSILON_MS  # always forward, whatever a machine reports
-            for c in self.controllers:
-                c.advance(done)
-            self._carry()
+        """Run the wired machines together, instant by instant, up to `now`."""
+        if self.wires:  # else nothing joins them: each runs alone in its own `tick`
+            self._wired.run_until(round(now * US_PER_S))
 
     def _carry(self) -> None:
-        """Every wired input takes its outputs' level, set once: an input that two outputs
-        drive (`check` refuses such a rig) is ON while either is, never toggled in between."""
-        levels: dict[tuple[VirtualController, int], bool] = {}
-        for wire in self.wires:
-            key = (wire.target, wire.input)
-            levels[key] = levels.get(key, False) or wire.level()
-        for (target, n), on in levels.items():
-            target.machine.set_input(n, on)
+        """Every wired input takes its outputs' level where the machines stand."""
+        if self.wires:
+            self._wired.carry(min(c.machine.now_us for c in self.controllers))
+
+    def _guarded(self, address: int, work) -> None:
+        """A failure of one controller's firmware stops its macro, not the chain."""
+        self.by_address(address).run_safely(work)
 
 
 def at_addresses(addresses: Sequence[int], model: str, *, firmware: str = "2.30",

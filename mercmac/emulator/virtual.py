@@ -198,9 +198,13 @@ class VirtualController:
         self.advance(now * 1000)
 
     def advance(self, t_ms: float) -> None:
-        """Run the VM to `t_ms` (a chain steps its wired machines together); a failure
-        stops the macro, not the controller."""
-        self._safely("a running macro", self.machine.run_until, t_ms)
+        """Run the VM to `t_ms`; a failure stops the macro, not the controller."""
+        self.run_safely(lambda: self.machine.run_until(t_ms))
+
+    def run_safely(self, work: Callable[[], None]) -> None:
+        """`work` on the VM (a chain steps its wired machines together, vm/wiring.py); a
+        failure stops the macro, not the controller."""
+        self._safely("a running macro", work)
 
     def _run_due(self, now: float) -> None:
         """Also run what is due at `now` itself: the first command of a line just typed,

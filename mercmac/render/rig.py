@@ -80,7 +80,7 @@ def _with_name(line: Line, name: str, width: int) -> Line:
 
 def _edges(edges: list[Edge], width: int) -> Iterator[tuple[int, Line]]:
     for edge in edges:
-        t = round(edge.t_ms * 1000)
+        t = edge.t
         text = f"{edge.wire.source} -> {edge.wire.target} {'ON' if edge.level else 'OFF'}"
         yield t, one._at(t) + [(f"{'':<{width}}  wire {text}", "cyan")]
 
@@ -116,7 +116,7 @@ def to_json(result: RigRun) -> str:
         "rig": result.rig.name,
         "until_ms": result.until_ms,
         "controllers": {name: one.run_json(run) for name, run in result.runs.items()},
-        "edges": [{"t_ms": one.ms(round(e.t_ms * 1000)), "wire": str(e.wire),
+        "edges": [{"t_ms": one.ms(e.t), "wire": str(e.wire),
                    "source": str(e.wire.source), "target": str(e.wire.target),
                    "level": e.level} for e in result.edges[:CAP]],
     }

@@ -1,26 +1,13 @@
 """All controllers of a rig on one simulated clock (`sim RIG`, docs/rigs.md).
 
 Each controller is a Machine of its own (vm/machine.py) running its program; the rig
-advances them together, one instant at a time: the earliest event of any machine, of the
-joystick, or of a button script. MS176E §3.8 and §4.5.1 let axes interact only through
-wired I/O lines, so the wires are all the machines share.
-
-The ordering rule within one instant t (deterministic, and independent of the order of
-the controllers in the rig file):
-  1. every machine due at t processes its hardware events at t, then its command at t;
-     all of them read their inputs as they were before any command at t ran;
-  2. then every wire whose driving output changed takes the output's new level, and its
-     input changes at t (an InputChanged at t on the driven machine);
-  3. a machine that this lets go on (a WN/WF wait that ends) runs its next command at t
-     itself, so 1-3 repeat at t until no machine is due at t any more.
-So an output set at t reaches the wired input at t, before the driven machine runs any
-command after its wait; two commands at the same instant never see each other's outputs
-(as two controllers' clocks are not in step on the bench either).
+advances them together, one instant at a time, by the instant rule of vm/wiring.py (which
+the virtual chain of `emulate --rig` follows too): the earliest event of any machine, of
+the joystick, or of a button script.
 """
 from __future__ import annotations
 
 import heapq
-import math
 from dataclasses import dataclass, replace
 from typing import Iterable, Mapping, Sequence
 
@@ -33,17 +20,17 @@ from mercmac.sim.simulate import DEFAULT_UNTIL_MS, Run, machine_for, schedule
 from mercmac.timespec import Press
 from mercmac.vm import events as ev
 from mercmac.vm.machine import Listener, Machine, Wait
+from mercmac.vm.wiring import INF, Wired
 from mercmac.vm.models import Options
 
-INF = math.inf
 DEADLOCK = "rig-deadlock"  # vm/hazards.py MH008
 
 
 @dataclass(frozen=True, slots=True)
 class Edge:
-    """A wire changed level at t_ms (the driving output's new level)."""
+    """A wire changed level at t (us): the driving output's new level."""
 
-    t_ms: float
+    t: int
     wire: Wire
     level: bool
 
@@ -90,8 +77,8 @@ class RigSim:
             self.machines[c.name], self.records[c.name] = machine_for(
                 programs[c.name], model=c.model, cycle_ms=cycle_ms, options=own, trace=trace,
                 listeners=(listeners or {}).get(c.name, ()))
-        self.levels = {w: False for w in rig.wires}  # outputs are off at power-on (§3.4)
-        self.by_source = _by_source(rig.wires)
+        self.wired = Wired(self.machines, rig.wires,
+                           on_edge=lambda t, wire, level: self.add_edge(Edge(t, wire, level)))
         self.edges: list[Edge] = []
         self.edges_dropped = 0
         self.holds: list[tuple[int, int, str, float]] = []  # (t_us, order, controller, d)
@@ -120,7 +107,7 @@ class RigSim:
         self.deadlocked = False
         if self.joint is not None:
             self.joint.seen.clear()  # passes before the reset are no pattern for after it
-        self._propagate(round(self.now_ms() * 1000))
+        self.wired.carry(round(self.now_ms() * 1000))
 
     # ------------------------------------------------------------ the clock
     def run_until(self, until_ms: float) -> None:
@@ -138,43 +125,24 @@ class RigSim:
 
     def next_us(self) -> float:
         """The earliest event of any machine or of the joystick; inf when none is left."""
-        t = min((_next(m) for m in self.machines.values()), default=INF)
+        t = self.wired.next_us()
         return min(t, self.holds[0][0]) if self.holds else t
+
+    @property
+    def levels(self) -> dict[Wire, bool]:
+        """Each wire's level now (its driving output's)."""
+        return self.wired.levels
 
     def _instant(self, t: int) -> None:
         self._joystick(t)
-        due = [m for m in self.machines.values() if _next(m) <= t]
-        while due:
-            for m in due:
-                m.run_through(t)
-            self._propagate(t)
-            due = [m for m in self.machines.values() if _next(m) <= t]
+        self.wired.instant(t)
         if self.next_us() == INF:
             self._check_deadlock(t)
 
     def _joystick(self, t: int) -> None:
         while self.holds and self.holds[0][0] <= t:
             _, _, name, deflection = heapq.heappop(self.holds)
-            m = self._at_time(name, t)
-            m.set_joystick(deflection)
-
-    def _at_time(self, name: str, t: int) -> Machine:
-        """The machine `name`, its clock brought to t (nothing of it is due before t)."""
-        m = self.machines[name]
-        if m.now_us < t:
-            m.run(t)
-        return m
-
-    def _propagate(self, t: int) -> None:
-        """Every wire takes its driving output's level at t; changed inputs change at t."""
-        for name, wires in self.by_source.items():
-            pattern = self.machines[name].outputs.pattern(t)
-            for wire in wires:
-                level = bool(pattern >> (wire.source.number - 1) & 1)
-                if level != self.levels[wire]:
-                    self.levels[wire] = level
-                    self.add_edge(Edge(t / 1000, wire, level))
-                    self._at_time(wire.target.controller, t).set_input(wire.target.number, level)
+            self.wired.at(name, t).set_joystick(deflection)
 
     def add_edge(self, edge: Edge) -> None:
         """Keep an edge, up to CAP; past it, count it."""
@@ -250,23 +218,8 @@ class RigSim:
         return RigRun(self.rig, runs, self.edges, until_ms, self.edges_dropped, interrupted)
 
 
-def _by_source(wires: Iterable[Wire]) -> dict[str, list[Wire]]:
-    grouped: dict[str, list[Wire]] = {}
-    for wire in wires:
-        grouped.setdefault(wire.source.controller, []).append(wire)
-    return grouped
-
-
 def _word(on: bool) -> str:
     return "ON" if on else "OFF"
-
-
-def _next(m: Machine) -> float:
-    """The machine's next event in us (inf: none)."""
-    t = m.next_event_ms()
-    return t if t == INF else round(t * 1000)
-
-
 
 
 def simulate_rig(rig: Rig, programs: Mapping[str, Program], *,

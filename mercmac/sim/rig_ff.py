@@ -166,14 +166,13 @@ class JointForward:
         count = visit.edges - previous.edges
         if count == 0:
             return  # a pass that changes no wire: nothing to copy, whatever `passes` is
-        listed = [e for e in sim.edges if previous.t < round(e.t_ms * 1000) <= visit.t]
+        listed = [e for e in sim.edges if previous.t < e.t <= visit.t]
         if len(listed) < count:  # some of the pass's edges were past the cap already
             sim.edges_dropped += count * passes
             return
         for p in range(1, passes + 1):
-            for edge in listed:  # from whole microseconds, as stepping times them (t / 1000)
-                t = round(edge.t_ms * 1000) + p * period
-                sim.add_edge(type(edge)(t / 1000, edge.wire, edge.level))
+            for edge in listed:
+                sim.add_edge(type(edge)(edge.t + p * period, edge.wire, edge.level))
             if len(sim.edges) >= CAP:
                 sim.edges_dropped += count * (passes - p)
                 return

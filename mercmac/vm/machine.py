@@ -385,12 +385,6 @@ class Machine:
         """Advance simulated time to t_ms; motion continues when nothing runs."""
         self.run(round(t_ms * 1000))
 
-    def run_through(self, t: int) -> None:
-        """Process every event and instruction due at or before t (us) and stay at t, so that
-        an input set next happens at t (a rig's wires, sim/rig.py)."""
-        self.run(t + 1)
-        self.clock.now = t
-
     def set_joystick(self, deflection: float) -> None:
         """Hold the joystick at `deflection` (-1 full negative .. 1 full positive) from now on.
 
@@ -405,15 +399,18 @@ class Machine:
             self._drive_joystick()
 
     # ---------------------------------------------------------------- the loop
-    def run(self, until: int) -> None:
-        """Process every event and instruction due before `until` (us), then stop there."""
-        self.optimiser.running_to(until)
+    def run(self, until: int, *, through: bool = False) -> None:
+        """Process every event and instruction due before `until` (us), or `through` it
+        (at `until` too: an instant of wired machines, vm/wiring.py), then stop at `until`,
+        so that an input set next happens there."""
+        end = until + 1 if through else until  # whole us: due before until + 1 is due by until
+        self.optimiser.running_to(end)
         while True:
             t_hw = self._next_hardware()
             t_ins = self.wake if self.chunk is not None and self.block is None else INF
-            if t_hw <= t_ins and t_hw < until:  # inputs apply before a command at the same time
+            if t_hw <= t_ins and t_hw < end:  # inputs apply before a command at the same time
                 self._hardware(int(t_hw))
-            elif t_ins < until:
+            elif t_ins < end:
                 self.clock.now = t_ins
                 self.step()
             else:

@@ -35,7 +35,7 @@ def run(path: Path, until_ms: int, fast_forward: bool):
 
 def outcome(result) -> dict:
     """What a rig run shows: edges, and per controller its record and final machine."""
-    seen = {"edges": [(e.t_ms, str(e.wire), e.level) for e in result.edges],
+    seen = {"edges": [(e.t, str(e.wire), e.level) for e in result.edges],
             "dropped": result.edges_dropped}
     for name, r in result.runs.items():
         m = r.machine

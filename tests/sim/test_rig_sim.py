@@ -41,8 +41,8 @@ def test_an_output_reaches_the_wired_input_at_the_same_instant(tmp_path):
     (answer,) = events(result, "y", ev.OutputsChanged)
     assert seen.t == raised.t and (seen.input, seen.on) == (1, True)
     assert answer.t == raised.t  # the wait ends at t and y goes on at t itself
-    assert [(e.t_ms, str(e.wire), e.level) for e in result.edges] == [
-        (raised.t / 1000, "x.out1 -> y.in1", True)]
+    assert [(e.t, str(e.wire), e.level) for e in result.edges] == [
+        (raised.t, "x.out1 -> y.in1", True)]
 
 
 def test_the_raster_example_rasters():
@@ -163,7 +163,7 @@ def test_a_finished_rig_is_no_dead_lock(tmp_path):
 
 def outcome(result) -> dict:
     """All a run shows but how it got there (skips are events of their own)."""
-    return {"edges": [(e.t_ms, str(e.wire), e.level) for e in result.edges],
+    return {"edges": [(e.t, str(e.wire), e.level) for e in result.edges],
             "dropped": result.edges_dropped,
             **{name: (r.final(), [(e.t, e.pattern) for e in r.record.outputs],
                       [(e.t, e.text) for e in r.record.reports], r.record.dropped["outputs"],
