@@ -266,7 +266,7 @@ the duplicate.""", {"": "{kind} '{name}' is defined twice (first at line {first}
 
 RULES += (
     Rule("MM019", "goto-not-last", _E, "a goto is not the last statement of its block", """\
-`goto NAME` transfers for good (SPEC §1): it lowers to an EM that must end its
+`goto NAME` transfers for good: it lowers to an EM that must end its
 macro, because the controller keeps one return point (MS176E §3.8.4) and
 nothing after a transfer for good would ever run. So a goto may only be the
 last statement of its block, e.g. `when 1 { CN 1, goto run }`. Statements
@@ -278,7 +278,7 @@ after it are dead code: remove them, move them before the goto, or use
                 "a when block)",
     }),
     Rule("MM030", "goto-ends-loop", _W, "a repeat or every block ends in a goto: it runs once", """\
-A goto transfers for good (SPEC §1), so a loop whose block ends in one leaves
+A goto transfers for good, so a loop whose block ends in one leaves
 on its first pass: `repeat 3 { CN 1, TT, goto x }` means `CN 1, TT, goto x`,
 and mercmac lowers it so (`CN1,TT,EMx`). Code after such a loop never runs.
 Drop the loop, or put the goto in a `when` block so that it only leaves the
@@ -286,8 +286,8 @@ loop when an input says so.""", {"": "this goto ends the {kind} block (line {lin
               "block runs once. Drop the loop, or put the goto in a when block"}),
     Rule("MM031", "ti-moved", _W, "a TI runs in another macro than the RP of its loop", """\
 TI reports the remaining count of the RP in the running macro, and each macro
-has its own RP counters that reset when it is entered (MS176E §6.4 RP, TI;
-SPEC §3). A TI in a `when` block inside a loop runs in the macro the block is
+has its own RP counters that reset when it is entered (MS176E §6.4 RP, TI).
+A TI in a `when` block inside a loop runs in the macro the block is
 hoisted into, so it reports that macro's counter (0) instead of the loop's:
 `repeat 3 { when 1 { TI } }` reports 0, 0, 0 where the loop means 0, 2, 1.
 Move the TI out of the when block, straight into the loop.""", {"": "this TI runs in '{owner}', a macro of its own, not in '{loop}' with the RP "
@@ -298,7 +298,7 @@ Move the TI out of the when block, straight into the loop.""", {"": "this TI run
 cannot express it: a line always runs at least once, MS176E §6.4 RP). Remove
 the block, or give a count of 1 or more.""", {"": "repeat 0 never runs its block: it is left out"}),
     Rule("MM033", "every-zero", _W, "every 0ms: a polling loop without a wait", """`every 0ms { ... }` waits nothing between passes, so it is a busy loop: it runs
-at the full command rate, one command per controller cycle (SPEC §3), keeps the
+at the full command rate, one command per controller cycle, keeps the
 controller busy and floods the host with any reports the block makes. The
 simulator reports it as a busy-loop hazard. Give the loop a period of a few ms
 (`every 20ms`), which adds a WA to each pass.""", {
@@ -448,7 +448,7 @@ needs a loop to turn round, or a WF on a line left high, is not. Let one
 side raise its output first (in the autostart macro), or run `mercmac sim`
 on the rig to see the run.
 It also reports, at the wait, a dead-lock on an input that no wire and no
-box button drives, which stays OFF on the rig (SPEC §6): only a sure one.
+box button drives, which stays OFF on the rig: only a sure one.
 Each controller is followed from its autostart macro through the commands
 that surely run (no XN/XF condition, no loop without a wait); when each one
 ends or reaches a WN that never ends, on such an input or on a wire from an

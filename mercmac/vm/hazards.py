@@ -56,7 +56,7 @@ SV 20000, SA 250000, §3.4), or use WA to wait a fixed time.""", {
     Rule("MH006", "busy-loop", _W, "a long loop repeats without any wait, at the full command rate", """\
 A loop (RP, or macros that call each other round) that runs many passes
 without WA, WS, WN or WF executes at the full command rate, one command per
-controller cycle (SPEC §3). A polling loop like that keeps the controller
+controller cycle. A polling loop like that keeps the controller
 busy, floods the host with any reports it makes, and on a bench usually means
 a missing wait. Add a WA of a few ms to each pass (`every 20ms { ... }` does
 this for you).""", {
