@@ -193,7 +193,7 @@ def test_a_rig_state_file_is_named_in_its_folder_never_a_path(tmp_path):
     from mercmac.emulator.chain import for_rig
     from mercmac.outfile import OutputError
     from mercmac.rig.load import read_rig
-    from helpers.rig_files import RASTER
+    from helpers.rigs import RASTER
 
     rig = read_rig(str(RASTER)).rig
     hostile = changed(rig, controllers=(changed(rig.controllers[0], name="../../escaped"),

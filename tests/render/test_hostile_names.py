@@ -29,7 +29,7 @@ from markdown_it.tree import SyntaxTreeNode
 from helpers.cli import cli
 from helpers.emulator import FAST, FAST_TIMING, line_clock, serve
 from helpers.paths import EXAMPLE4, ROOT
-from helpers.rig_files import X, Y
+from helpers.rigs import X, Y
 from mercmac import names
 from mercmac.compiler import compile_file
 from mercmac.emulator.chain import Chain

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers.rig_files import DEAD_X, X, Y, write_rig
+from helpers.rigs import DEAD_X, X, Y, write_rig
 from mercmac.compiler import compile_file
 from mercmac.emulator.chain import Chain, Wiring
 from mercmac.emulator.virtual import VirtualController

@@ -8,7 +8,7 @@ import pytest
 
 from helpers.cli import cli, mercmac_process
 from mercmac.diagnostics import RULES
-from helpers.rig_files import DEAD_X, DEAD_Y, RASTER, WIRES, controllers, write_rig
+from helpers.rigs import DEAD_X, DEAD_Y, RASTER, WIRES, controllers, write_rig
 
 
 @pytest.fixture

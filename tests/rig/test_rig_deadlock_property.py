@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 
 from helpers.budgets import budget
-from helpers.rig_sim import rig_of
+from helpers.rigs import rig_of
 from mercmac.compiler import checking, compile_file
 from mercmac.rig.checks import check_rig_path
 from mercmac.rig.load import read_rig

@@ -6,7 +6,7 @@ import pytest
 
 from mercmac.rig.load import is_rig_path, read_rig
 from mercmac.rig.model import LineKind
-from helpers.rig_files import RASTER, WIRES, X, controllers, write_rig
+from helpers.rigs import RASTER, WIRES, X, controllers, write_rig
 
 
 def _found(path) -> list[tuple[str, int, int, str]]:

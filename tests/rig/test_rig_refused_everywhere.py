@@ -11,7 +11,7 @@ import sys
 import pytest
 
 from helpers.cli import cli
-from helpers.rig_files import WIRES, X, Y, controllers, write_rig
+from helpers.rigs import WIRES, X, Y, controllers, write_rig
 
 JOYSTICK = WIRES + controllers() + "[joystick]\n"
 # (the rule check reports, the rig file's TOML or None for the default, x.mcm, y.mcm)

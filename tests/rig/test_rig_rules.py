@@ -8,7 +8,7 @@ from mercmac.compiler import checking
 from mercmac.diagnostics import RULES
 from mercmac.rig.accept import accept
 from mercmac.rig.checks import check_rig_path
-from helpers.rig_files import DEAD_X, DEAD_Y, RASTER, WIRES, X, Y, controllers, write_rig
+from helpers.rigs import DEAD_X, DEAD_Y, RASTER, WIRES, X, Y, controllers, write_rig
 
 RIG_CODES = {r.code for r in RULES if r.code.startswith("MR")}
 

@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from helpers.budgets import budget
-from helpers.rig_sim import rig_of
+from helpers.rigs import rig_of
 from mercmac.compiler import compile_file
 from mercmac.rig.load import read_rig
 from mercmac.sim import record as record_module

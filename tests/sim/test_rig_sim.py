@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers.rig_sim import RASTER, rig_of, rig_of_one
+from helpers.rigs import RASTER, rig_of, rig_of_one
 from mercmac.compiler import compile_file
 from mercmac.render import explain
 from mercmac.rig.load import read_rig

@@ -8,7 +8,7 @@ import json
 import pytest
 
 from helpers.cli import cli, mercmac_process, sim
-from helpers.rig_sim import RASTER, rig_of
+from helpers.rigs import RASTER, rig_of
 
 SPEC_KEYS = {"until_ms", "halted", "final", "reports", "outputs", "hazards", "events"}
 

@@ -8,7 +8,7 @@ import sys
 import pytest
 
 from helpers.cli import sim
-from helpers.rig_sim import RASTER, rig_of
+from helpers.rigs import RASTER, rig_of
 from test_sim_interactive import Terminal
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="needs a POSIX pty")

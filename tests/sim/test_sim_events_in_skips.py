@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from helpers.budgets import budget
 from helpers.compiling import program_of
-from helpers.rig_sim import RASTER
+from helpers.rigs import RASTER
 from mercmac.compiler import compile_file
 from mercmac.rig.load import read_rig
 from mercmac.sim.rig import simulate_rig

@@ -251,7 +251,7 @@ def test_pull_rig_does_not_merge_two_controllers_at_one_address(tmp_path, data_d
 def test_a_history_name_like_another_address_does_not_merge_two_controllers(tmp_path, data_dir):
     """The history names address 0 `a1`; address 1, never flashed, is a1 by its address:
     each still gets its own file and table."""
-    from helpers.rig_files import X, write_rig
+    from helpers.rigs import X, write_rig
 
     toml = ('[controllers.a1]\naddress = 0\nmodel = "C-663"\nprogram = "x.mcm"\n'
             '[controllers.y]\naddress = 1\nmodel = "C-663"\nprogram = "y.mcm"\n')
