@@ -14,30 +14,14 @@ from mercmac.decompile import decompile, read_macros
 from mercmac.diagnostics import Severity
 from mercmac.source import Source
 from helpers.budgets import budget
+from helpers.decompiling import build, round_trip, stored
 from helpers.paths import EXAMPLE4, EXAMPLE_FILES, FOUR_MODES
-from helpers.programs import programs
-
-
-def _build(text: str, name: str = "x.mcm"):
-    comp = compile_source(Source(name, text))
-    assert comp.program is not None, [d.message for d in comp.report.items]
-    return comp
-
-
-def _stored(program) -> dict[int, str]:
-    return {m.slot: mdtext.normal(m.line) for m in program.macros.values()}
+from helpers.programs import RAW_COMMANDS, programs
 
 
 def _noise(comp) -> Counter:
     return Counter(d.rule.name for d in comp.report.items
                    if d.severity in (Severity.ERROR, Severity.WARNING))
-
-
-def _round_trip(macros: dict[int, str]) -> str:
-    source = decompile(macros)
-    comp = _build(source)
-    assert _stored(comp.program) == {s: mdtext.normal(t) for s, t in macros.items()}, source
-    return source
 
 
 @pytest.mark.parametrize("path", EXAMPLE_FILES, ids=lambda p: p.stem)
@@ -48,7 +32,7 @@ def test_every_example_round_trips(path):
         source = decompile(macros)
         assert "[MC18]" in source and "kept raw" in source
         return
-    _round_trip({m.slot: m.line for m in comp.program.macros.values()})
+    round_trip({m.slot: m.line for m in comp.program.macros.values()})
 
 
 @pytest.mark.parametrize("path", [p for p in EXAMPLE_FILES if p.stem.startswith("manual-")],
@@ -56,11 +40,11 @@ def test_every_example_round_trips(path):
 def test_the_manuals_raw_files_round_trip(path):
     macros = read_macros(path.read_text())
     readable = {s: t for s, t in macros.items() if not mdtext.parse_line(t).errors}
-    _round_trip(readable)
+    round_trip(readable)
 
 
 def test_example_4_uses_the_high_level_constructs():
-    source = _round_trip(read_macros(EXAMPLE4.read_text()))
+    source = round_trip(read_macros(EXAMPLE4.read_text()))
     for text in ("target C-863", "autostart {", "macro init", "every 20ms", "when 1 {",
                  "goto mode_1", "// MC16"):
         assert text in source
@@ -68,9 +52,9 @@ def test_example_4_uses_the_high_level_constructs():
 
 def test_four_modes_decompiles_to_what_it_was_and_checks_no_worse():
     path = FOUR_MODES
-    original = _build(path.read_text(), path.name)
-    source = _round_trip(_stored(original.program))
-    again = _build(source)
+    original = build(path.read_text(), path.name)
+    source = round_trip(stored(original.program))
+    again = build(source)
     assert not _noise(again) - _noise(original), source
     assert source.count("when ") == 17 and "every 100ms" in source and "@" not in source
 
@@ -78,8 +62,8 @@ def test_four_modes_decompiles_to_what_it_was_and_checks_no_worse():
 @pytest.mark.parametrize("path", [p for p in EXAMPLE_FILES if not p.stem.startswith("manual-")],
                          ids=lambda p: p.stem)
 def test_built_examples_decompile_with_no_new_warning(path):
-    original = _build(path.read_text(), path.name)
-    again = _build(_round_trip(_stored(original.program)))
+    original = build(path.read_text(), path.name)
+    again = build(round_trip(stored(original.program)))
     assert not _noise(again) - _noise(original)
 
 
@@ -94,17 +78,12 @@ def test_model_from_ve():
 
 # -- properties -----------------------------------------------------------------------------------
 
-COMMANDS = st.sampled_from([
-    "MR5000", "MR-200", "MA100", "WS10", "WA20", "CP3", "CN1", "CF2", "SV9000", "AB1", "GH",
-    "WF1", "WN2", "XN1", "XF2", "XN3", "RP", "RP3", "TP", "DH", "ZM1"])
-
-
 @st.composite
 def raw_programs(draw):
     slots = draw(st.lists(st.integers(0, 31), min_size=1, max_size=8, unique=True))
     macros = {}
     for slot in slots:
-        ops = draw(st.lists(st.one_of(COMMANDS, st.sampled_from(slots).filter(bool).map(
+        ops = draw(st.lists(st.one_of(RAW_COMMANDS, st.sampled_from(slots).filter(bool).map(
             lambda s: f"{Mnemonic.EM}{s}")), min_size=1, max_size=16))
         macros[slot] = ",".join(ops)
     return macros
@@ -113,7 +92,7 @@ def raw_programs(draw):
 @settings(max_examples=budget(60), deadline=None, suppress_health_check=list(HealthCheck))
 @given(raw_programs())
 def test_random_raw_programs_round_trip(macros):
-    _round_trip(macros)
+    round_trip(macros)
 
 
 @settings(max_examples=budget(60), deadline=None, suppress_health_check=list(HealthCheck))
@@ -122,4 +101,4 @@ def test_built_programs_round_trip(text):
     comp = compile_source(Source("gen.mcm", text))
     if comp.program is None or any(d.severity is Severity.ERROR for d in comp.report.items):
         return
-    _round_trip(_stored(comp.program))
+    round_trip(stored(comp.program))

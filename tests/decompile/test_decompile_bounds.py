@@ -15,7 +15,8 @@ from hypothesis import strategies as st
 from benchmarks.decompile_speed import chain
 from mercmac.commands import Mnemonic
 from helpers.budgets import budget
-from test_decompile import COMMANDS, _round_trip
+from helpers.decompiling import round_trip
+from helpers.programs import RAW_COMMANDS
 
 # Statement sequences one decompile may lower: the worst of the benchmark's programs
 # needs about 3,300; the chain of 20 needed over a million per candidate before.
@@ -50,14 +51,14 @@ PROGRAMS = {f"chain of {n}": chain(n) for n in (20, 24, 32)}
 
 @pytest.mark.parametrize("name", PROGRAMS)
 def test_worst_shapes_round_trip_with_bounded_work(counted, name):
-    source = _round_trip(PROGRAMS[name])
+    source = round_trip(PROGRAMS[name])
     assert "Decompiled by mercmac" in source
 
 
 def test_a_chain_of_32_is_nested_at_most_a_few_deep(counted):
     from mercmac.decompile.source import MAX_NEST
 
-    source = _round_trip(chain(32))
+    source = round_trip(chain(32))
     depth = max(len(line) - len(line.lstrip(" ")) for line in source.split("\n")) // 4
     assert depth <= MAX_NEST + 1  # the macro's body, and its folded blocks
 
@@ -69,7 +70,7 @@ CONDITIONS = st.sampled_from(["XN1", "XF2", "XN3"])
 def free_programs(draw):
     """Raw programs of all 32 slots, each 1-16 commands, with EMs to any slot."""
     em = st.integers(1, 31).map(lambda s: f"{Mnemonic.EM}{s}")
-    line = st.lists(st.one_of(COMMANDS, em, em), min_size=1, max_size=16).map(",".join)
+    line = st.lists(st.one_of(RAW_COMMANDS, em, em), min_size=1, max_size=16).map(",".join)
     return {slot: draw(line) for slot in range(32)}
 
 
@@ -80,9 +81,9 @@ def chained_programs(draw):
     macros = {}
     for slot in range(32):
         ops = draw(st.lists(CONDITIONS, min_size=1, max_size=2))
-        ops += draw(st.lists(COMMANDS, max_size=3))
+        ops += draw(st.lists(RAW_COMMANDS, max_size=3))
         ops += [f"{Mnemonic.EM}{slot + 1}"] if slot < 31 else []
-        macros[slot] = ",".join(ops + draw(st.lists(COMMANDS, min_size=1, max_size=3)))
+        macros[slot] = ",".join(ops + draw(st.lists(RAW_COMMANDS, min_size=1, max_size=3)))
     return macros
 
 
@@ -91,4 +92,4 @@ def chained_programs(draw):
 @given(st.one_of(free_programs(), chained_programs()))
 def test_random_32_slot_programs_round_trip_with_bounded_work(counted, macros):
     counted[0] = 0
-    _round_trip(macros)
+    round_trip(macros)

@@ -9,33 +9,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from helpers.budgets import budget
-from helpers.compiling import compile_text
+from helpers.formatting import assert_formats_safely
 from helpers.paths import EXAMPLES, EXAMPLE_FILES
 from mercmac.cli import main
 from mercmac.fmt import FormatError, format_text, load
 from helpers.programs import programs
-
-COMMENT = re.compile(r"//[^\n]*")
-
-
-def build(text: str):
-    """What the formatter must never change: the MD lines and the rules found."""
-    result = compile_text(text)
-    lines = result.program.md_lines() if result.program is not None else None
-    return lines, sorted(d.rule.name for d in result.report.items)
-
-
-def comments(text: str) -> list[str]:
-    return [c.rstrip() for c in COMMENT.findall(text.replace("\r", ""))]
-
-
-def assert_formats_safely(text: str) -> str:
-    formatted = format_text(text)
-    assert format_text(formatted) == formatted, formatted
-    assert build(formatted) == build(text), (text, formatted)
-    assert comments(formatted) == comments(text)
-    return formatted
-
 
 # -- the layout ---------------------------------------------------------------------------------
 

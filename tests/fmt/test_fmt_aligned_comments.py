@@ -8,11 +8,11 @@ import pytest
 from markdown_it import MarkdownIt
 
 from helpers.cli import cli
+from helpers.formatting import assert_formats_safely
 from helpers.paths import EXAMPLES, ROOT
+from helpers.readme import README
 from mercmac.fmt import format_text
-from test_fmt import assert_formats_safely
 
-README = (ROOT / "README.md").read_text(encoding="utf-8")
 # A code block is a .mcm program when its first line starts what a .mcm file holds: a
 # comment, `target`, `const`, `macro`, `autostart` or a raw `[MCnn]` block. The README's
 # other blocks are shell commands, TOML and YAML (`[tool.mercmac]` is no `[MC`).

@@ -10,7 +10,8 @@ import serial
 from mercmac.emulator.ptyserver import PtyServer
 from mercmac.emulator.virtual import Faults, VirtualController
 from mercmac.upload import controller as controller_module, transport as transport_module
-from mercmac.upload.connect import open_controller
+from mercmac.upload.connect import identify, open_controller
+from mercmac.upload.flasher import FlashOptions, flash
 from mercmac.upload.transport import Timing
 
 # The answer timeout of the tests' exchanges, FAST_TIMING for the library and FAST for the
@@ -87,6 +88,16 @@ def until(condition, seconds: float = ROOM_S) -> bool:
 def connect(server, address: int = 0, timing: Timing = FAST_TIMING):
     with open_controller(server.path, address, timing=timing) as c:
         yield c
+
+
+def run_flash(server, program, tmp_path, address=0, **options):
+    """Flash `program` through the library at `address` (backup in tmp_path unless given):
+    (the flash's result, the transport that carried it)."""
+    with connect(server, address) as c:
+        who = identify(c)
+        options.setdefault("backup", tmp_path / "backup.mcm")
+        result = flash(c, who, program, FlashOptions(**options))
+        return result, c.transport
 
 
 @contextmanager

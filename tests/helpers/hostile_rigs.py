@@ -15,10 +15,9 @@ import random
 from pathlib import Path
 
 from helpers.paths import EXAMPLES
+from helpers.rigs import X as GOOD, Y as OTHER  # the two wired controllers, well formed
 
 SECRET = "aws_secret_access_key = SECRET-d41d8cd98f00"
-GOOD = "target C-663\nmacro go { MR 100, WS 0, CN 1, WN 2, CF 1, WF 2, goto go }\nautostart { goto go }\n"
-OTHER = "target C-663\nmacro go { WN 1, MR 10, WS 0, CN 2, WF 1, CF 2, goto go }\nautostart { goto go }\n"
 WRONG = "target C-863\nautostart { SC 2, DP 200, WN 3, CN 1 }\n"  # SC in macro 0, model
 NAMES = ["x", "y", "z", "left", "b2", "bad name", "../x", "a" * 300, "x\x1b[2J", "é", "1x", ""]
 RIG_NAMES = ["raster", "../../x", "/abs/x", "a/b", "x\x1b]52;c;cHduZWQ=\x07", "\u202eevil",

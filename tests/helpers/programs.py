@@ -57,3 +57,9 @@ def programs(draw):
         text.append(f"macro mode{i} {{\n  " + "\n  ".join(draw(block(0, leaves, modes, False, False))) + "\n}")
     text.append("autostart {\n  " + "\n  ".join(draw(block(0, leaves, modes, False, False))) + "\n}")
     return "\n".join(text) + "\n"
+
+# Raw native commands for the decompiler's raw programs (MS176E §6): moves, waits, I/O
+# conditions, repeats; an EM to another slot is drawn beside them.
+RAW_COMMANDS = st.sampled_from([
+    "MR5000", "MR-200", "MA100", "WS10", "WA20", "CP3", "CN1", "CF2", "SV9000", "AB1", "GH",
+    "WF1", "WN2", "XN1", "XF2", "XN3", "RP", "RP3", "TP", "DH", "ZM1"])

@@ -10,6 +10,11 @@ from helpers.paths import EXAMPLE4, ROOT
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 
 
+def setup_commands() -> list[str]:
+    """The README's opening commands: the install line, then the test command CI runs."""
+    return [line.strip() for line in README.splitlines()[:6] if line.startswith("    ")]
+
+
 def code_lines() -> list[str]:
     """The lines of the README's indented code blocks (fenced ones are other languages)."""
     lines, fenced, previous_blank = [], False, True

@@ -8,7 +8,7 @@ import subprocess
 import sys
 
 from helpers.paths import ROOT
-from test_readme import setup_commands
+from helpers.readme import setup_commands
 
 SCRIPT = ROOT / "tools" / "loaded_suite.py"
 

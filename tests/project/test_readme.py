@@ -2,11 +2,7 @@
 from __future__ import annotations
 
 from helpers.paths import ROOT
-
-
-def setup_commands() -> list[str]:
-    lines = (ROOT / "README.md").read_text(encoding="utf-8").splitlines()
-    return [l.strip() for l in lines[:6] if l.startswith("    ")]
+from helpers.readme import setup_commands
 
 
 def test_readme_opens_with_two_setup_commands():

@@ -26,13 +26,25 @@ def _imported(tree: ast.Module) -> list[str]:
 
 
 @pytest.mark.parametrize("path", TEST_FILES, ids=lambda p: str(p.relative_to(TESTS)))
-def test_shared_code_comes_from_helpers_and_a_test_imports_only_its_neighbours(path):
-    # conftest, `tests.x` and a test module of another folder resolve only from some places
-    # (tests/ itself, the root as the current folder, the order of collection)
+def test_shared_code_comes_from_helpers(path):
+    # conftest and `tests.x` resolve only from some places (tests/ itself, the root as the
+    # current folder); lsp_wire and semantics are helpers' modules, not top-level ones
     wrong = [m for m in _imported(_tree(path))
-             if m in ("conftest", "lsp_wire", "semantics") or m.split(".")[0] == "tests"
-             or (m.startswith("test_") and not (path.parent / f"{m}.py").exists())]
-    assert not wrong, f"{path.name} imports {wrong}: import helpers.* (or a test of its own folder)"
+             if m in ("conftest", "lsp_wire", "semantics") or m.split(".")[0] == "tests"]
+    assert not wrong, f"{path.name} imports {wrong}: import helpers.*"
+
+
+@pytest.mark.parametrize("path", sorted(TESTS.rglob("*.py")),
+                         ids=lambda p: str(p.relative_to(TESTS)))
+def test_no_file_imports_a_test_module(path):
+    # importing a test module runs its module-level code in the importer (its skips too),
+    # resolves only while pytest has put that test's folder on sys.path, and ties one test
+    # to another's file: what two tests share lives in tests/helpers/
+    named = [n.module or "" for n in ast.walk(_tree(path)) if isinstance(n, ast.ImportFrom)] + \
+        [a.name for n in ast.walk(_tree(path)) if isinstance(n, (ast.Import, ast.ImportFrom))
+         for a in n.names]  # `from sim import test_x` names the module among the names
+    wrong = [m for m in named if any(part.startswith("test_") for part in m.split("."))]
+    assert not wrong, f"{path.relative_to(TESTS)} imports {wrong}: move it to tests/helpers/"
 
 
 @pytest.mark.parametrize("path", TEST_FILES, ids=lambda p: str(p.relative_to(TESTS)))

@@ -14,8 +14,8 @@ import shlex
 import pytest
 
 from helpers.cli import cli
+from helpers.plots import inline_svg, page_data, svg_texts
 from helpers.readme import commands, tour_program
-from test_sim_plot import _inline_svg, _page_data, _svg_texts
 
 pytest.importorskip("matplotlib")
 
@@ -117,7 +117,7 @@ def test_a_move_still_running_after_the_program_ended_is_not_idle(tmp_path):
     (tmp_path / "far.mcm").write_text(f"autostart {{ MR {FAR} }}\n", encoding="utf-8")
     assert cli("sim", tmp_path / "far.mcm", "--until", "1min", "--plot",
                tmp_path / "far.html").exit_code == 0
-    data = _page_data((tmp_path / "far.html").read_text(encoding="utf-8"))
+    data = page_data((tmp_path / "far.html").read_text(encoding="utf-8"))
     assert data["ended_ms"] is not None and data["compressed"] == []
     assert data["clipped_targets"] == [[0.0, FAR]]
 
@@ -125,7 +125,7 @@ def test_a_move_still_running_after_the_program_ended_is_not_idle(tmp_path):
 def test_the_html_page_follows_the_same_rules(tmp_path):
     _tour(tmp_path, tmp_path / "tour.html")
     page = (tmp_path / "tour.html").read_text(encoding="utf-8")
-    data, texts = _page_data(page), _svg_texts(_inline_svg(page))
+    data, texts = page_data(page), svg_texts(inline_svg(page))
     low, high = data["position_range"]
     assert low <= 0 and 20_650 <= high < 2 * 20_650
     assert [x for _, x in data["clipped_targets"]] == [FAR]
@@ -133,9 +133,9 @@ def test_the_html_page_follows_the_same_rules(tmp_path):
     assert "jog (MC01)" in texts and "jog.when@11 (MC03)" not in texts  # too long for its bar
     _once(tmp_path, tmp_path / "once.html")
     page = (tmp_path / "once.html").read_text(encoding="utf-8")
-    data = _page_data(page)
+    data = page_data(page)
     assert data["compressed"] == [[pytest.approx(ARRIVED_MS), 3_600_000, "idle"]]
-    assert "idle: program ended" in " ".join(_svg_texts(_inline_svg(page)))
+    assert "idle: program ended" in " ".join(svg_texts(inline_svg(page)))
 
 
 def test_the_run_starts_at_0_s_before_thousands_of_bands():

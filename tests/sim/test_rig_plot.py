@@ -13,7 +13,7 @@ import re
 import pytest
 
 from helpers.compiling import program_of
-from test_sim_plot import _inline_svg, _page_data, _svg_texts
+from helpers.plots import inline_svg, page_data, svg_texts
 
 pytest.importorskip("matplotlib")
 
@@ -220,9 +220,9 @@ def test_the_html_page_holds_the_lanes_and_the_path(raster, tmp_path):
     out = tmp_path / "rig.html"
     rig_plot.write(str(out), rt, "mercmac sim raster.rig.toml")
     page = out.read_text()
-    texts = _svg_texts(_inline_svg(page))
+    texts = svg_texts(inline_svg(page))
     assert {"x: position (counts)", "y: position (counts)", "wires", "start", "end"} <= set(texts)
-    data = _page_data(page)
+    data = page_data(page)
     assert data["controllers"] == ["x", "y"] and set(data["lanes"]) == {"x", "y"}
     assert data["path"]["axes"] == ["x", "y"]
     assert data["path"]["points"][0][1:] == [0, 0]

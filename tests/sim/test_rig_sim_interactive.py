@@ -9,7 +9,7 @@ import pytest
 
 from helpers.cli import sim
 from helpers.rigs import RASTER, rig_of
-from test_sim_interactive import Terminal
+from helpers.terminal import Terminal
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="needs a POSIX pty")
 

@@ -6,16 +6,15 @@ pictures themselves were looked at by eye; these tests pin what a file holds.
 """
 from __future__ import annotations
 
-import json
 import re
 import sys
 import time
-import xml.etree.ElementTree as ET
 
 import pytest
 
 from helpers.cli import cli
 from helpers.paths import EXAMPLE4, EXAMPLE4_MODE2, ROOT
+from helpers.plots import inline_svg, page_data, svg_texts
 
 pytest.importorskip("matplotlib")
 
@@ -23,22 +22,10 @@ from mercmac.sim import plot  # noqa: E402  (needs matplotlib only when drawing)
 
 BLINK = "autostart {\n  every 500ms { CN 1, WA 500, CF 1 }\n}\n"  # CN1,WA500,CF1,WA500,RP,RP
 MAGIC = {"png": b"\x89PNG\r\n\x1a\n", "pdf": b"%PDF-", "svg": b"<?xml", "html": b"<!DOCTYPE html>"}
-SVG = "{http://www.w3.org/2000/svg}"
 
 
 def _example4(out, *more):
     return cli("sim", EXAMPLE4, "--scenario", EXAMPLE4_MODE2, "--plot", out, *more)
-
-
-def _svg_texts(svg: str) -> list[str]:
-    root = ET.fromstring(svg)
-    return ["".join(t.itertext()).strip() for t in root.iter(f"{SVG}text")]
-
-
-def _page_data(page: str) -> dict:
-    block = re.search(r'<script type="application/json" id="mercmac-plot-data">(.*?)</script>',
-                      page, re.S)
-    return json.loads(block.group(1))
 
 
 @pytest.mark.parametrize("kind", ["png", "svg", "pdf", "html"])
@@ -53,7 +40,7 @@ def test_each_kind_of_file_is_made(tmp_path, kind):
 def test_the_svg_holds_the_lanes_and_the_macros_by_name(tmp_path):
     out = tmp_path / "run.svg"
     assert _example4(out).exit_code == 0
-    texts = _svg_texts(out.read_text())
+    texts = svg_texts(out.read_text())
     for lane in ("position", "target", "buttons", "LEDs", "macro"):
         assert lane in texts
     assert {"MC22", "MC21", "MC25", "MC20"} <= set(texts)  # Example 4, mode 2: the macros run
@@ -65,8 +52,8 @@ def test_the_html_page_is_self_contained_and_holds_the_lanes_data(tmp_path):
     page = out.read_text()
     assert "<script src" not in page and "http-equiv" not in page  # nothing fetched
     assert "wheel" in page and "pointermove" in page  # zooms and pans
-    assert {"position", "buttons", "LEDs", "macro"} <= set(_svg_texts(_inline_svg(page)))
-    data = _page_data(page)
+    assert {"position", "buttons", "LEDs", "macro"} <= set(svg_texts(inline_svg(page)))
+    data = page_data(page)
     assert data["lanes"] == ["position", "buttons", "LEDs", "macro"]
     assert data["buttons"]["2"][0] == [0, 400]  # the scenario holds button 2 to 400 ms
     assert data["buttons"]["1"] == [[1000, 1300]]
@@ -74,10 +61,6 @@ def test_the_html_page_is_self_contained_and_holds_the_lanes_data(tmp_path):
     assert data["position"][-1][1] == 0 and max(x for _, x in data["position"]) == 100_000
     targets = [x for _, x in data["target"]]
     assert targets[targets.index(50_000):] == [50_000, 100_000, 0, 0]  # MA50000, MA100000, GH
-
-
-def _inline_svg(page: str) -> str:
-    return page[page.index("<svg"):page.index("</svg>") + len("</svg>")]
 
 
 def test_a_missing_extra_is_a_clear_message_before_simulating(tmp_path, monkeypatch):
@@ -135,10 +118,10 @@ def test_a_fast_forwarded_day_plots_quickly_with_the_stretch_compressed(tmp_path
     assert result.exit_code == 0, result.output
     assert time.monotonic() - started < 30  # 172,284 LED changes, not drawn one by one
     page = out.read_text()
-    data = _page_data(page)
+    data = page_data(page)
     assert data["fast_forwarded"] and data["end_ms"] == 86_400_000
     assert len(data["LEDs"]["1"]) < 100
-    assert "fast-forwarded" in " ".join(_svg_texts(_inline_svg(page)))
+    assert "fast-forwarded" in " ".join(svg_texts(inline_svg(page)))
 
 
 def test_a_long_skip_is_drawn_short_and_a_short_one_to_scale():

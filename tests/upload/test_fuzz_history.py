@@ -26,7 +26,7 @@ from mercmac.cli import main
 from helpers.budgets import fuzz_budget
 from helpers.cli import KNOWN_EXITS, hang_guard
 from helpers.emulator import FAST, serve_clocked
-from test_hostile_history import PROGRAM
+from helpers.history import PROGRAM
 
 pytestmark = pytest.mark.skipif(not (hasattr(os, "openpty") and hasattr(os, "mkfifo")),
                                 reason="needs pseudo-terminals and FIFOs")

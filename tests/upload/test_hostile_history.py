@@ -18,12 +18,9 @@ import pytest
 
 from helpers.cli import cli
 from helpers.emulator import FAST, serve
+from helpers.history import PROGRAM
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs pseudo-terminals")
-
-PROGRAM = ("target C-863\n\nmacro step @5 {   // the step\n    MR 5000, WS 100\n}\n\n"
-           "autostart { call step }\n")
-
 
 @pytest.fixture
 def flashed(tmp_path, data_dir):

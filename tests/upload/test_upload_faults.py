@@ -17,8 +17,7 @@ from mercmac.upload.flasher import FlashOptions, flash
 from mercmac.upload.connect import check_model, identify, open_controller
 from mercmac.upload.transport import Timing
 from helpers.compiling import program_of
-from helpers.emulator import FAST_TIMING, connect, serve, serve_clocked, timeouts
-from test_upload_flash import run_flash
+from helpers.emulator import FAST_TIMING, connect, run_flash, serve, serve_clocked, timeouts
 
 PROGRAM = "target C-863\n[MC00] EM5\n[MC05] MR5000,WS100\n[MC06] XN1,MR-10\n[MC07] TP\n"
 SILENCE_TIMING = Timing(timeout=0.3, settle=0.05)

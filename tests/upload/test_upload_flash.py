@@ -11,16 +11,8 @@ from mercmac.emulator.virtual import Faults
 from mercmac.upload.flasher import FlashOptions, flash
 from mercmac.upload.plan import Fate
 from mercmac.upload.connect import identify
-from helpers.emulator import connect, eventually, serve
+from helpers.emulator import eventually, run_flash, serve
 from helpers.paths import EXAMPLE4, ROOT
-
-
-def run_flash(server, program, tmp_path, address=0, **options):
-    with connect(server, address) as c:
-        who = identify(c)
-        options.setdefault("backup", tmp_path / "backup.mcm")
-        result = flash(c, who, program, FlashOptions(**options))
-        return result, c.transport
 
 
 def stored_equals(vc, program) -> bool:

@@ -12,10 +12,10 @@ from hypothesis import strategies as st
 
 from helpers.budgets import budget
 from helpers.compiling import program_of
+from helpers.simulation import skips, states
 from mercmac.compiler.program import Macro, Op, Program
 from mercmac.sim import record as record_module
 from mercmac.vm.models import Options
-from vm.test_ff_shift import skips, states
 
 # a scan that reads TS every pass, from well below the reference edge (at 0) across it
 TS_SCAN = "autostart {\n  MA -3000, WS 0\n  every 10ms { MR 7, WS 0, TS }\n}\n"

@@ -14,38 +14,19 @@ from hypothesis import strategies as st
 
 from helpers.budgets import budget
 from helpers.compiling import program_of
-from helpers.simulation import observed
+from helpers.simulation import skips, states
 from mercmac.compiler.program import Macro, Op, Program
 from mercmac.timespec import Press
-from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
 from mercmac.vm.models import Options
 from mercmac.sim import record as record_module
 from mercmac.cli import main
 from mercmac.render import progress as progress_module
 from mercmac.cli import run as sim_run
-from mercmac.sim.simulate import machine_for, schedule, simulate
+from mercmac.sim.simulate import machine_for, simulate
 
 DAY_MS = 86_400_000
 JOG = "autostart {\n  every 10ms { MR 1, WS 0 }\n}\n"  # MR1,WS0,WA10,RP,RP
-
-
-def states(program: Program, mode: str, checkpoints: list[int], presses=(), options=None):
-    """Reports, outputs, hazards and the machine at each checkpoint (ms), stepping or skipping."""
-    machine, record = machine_for(program, fast_forward=mode, options=options)
-    schedule(machine, presses)
-    machine.power_on()
-    seen = []
-    for t in checkpoints:
-        machine.run_until(t)
-        m = machine
-        seen.append((m.clock.now, m.position(), m.target, m.velocity(), m.moving(), m.macro,
-                     m.ip, m.counters, m.block, m.wake, m.error, m.outputs_pattern()))
-    return {**observed(record), "states": seen}, record
-
-
-def skips(record) -> list[ev.FastForwarded]:
-    return [e for e in record.timeline if isinstance(e, ev.FastForwarded)]
 
 
 def test_a_jog_loop_is_skipped_and_lands_where_stepping_does():
