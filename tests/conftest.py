@@ -91,3 +91,20 @@ def _private_data_dir(tmp_path_factory, monkeypatch):
     """Backups and flash history go to a fresh folder, never the user's data directory."""
     monkeypatch.delenv("MERCMAC_DATA_DIR", raising=False)
     monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path_factory.mktemp("xdg-data")))
+
+
+@pytest.fixture(autouse=True)
+def _no_emulator_left_serving():
+    """A virtual controller's thread ends with its test: one left serving reads whatever pty
+    later gets its file descriptor, and answered another test's host from a stale chain."""
+    import threading
+
+    def serving() -> set:
+        return {t for t in threading.enumerate() if t.name == "mercmac-emulator" and t.is_alive()}
+
+    before = serving()
+    yield
+    left = serving() - before
+    for thread in left:
+        thread.join(1.0)  # a closed server's last turn may still be ending
+    assert not serving() - before, "a virtual controller is still serving after its test"

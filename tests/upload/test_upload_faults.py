@@ -155,17 +155,23 @@ def test_the_port_disappears_mid_flash(tmp_path, monkeypatch):
 
 
 def test_ctrl_c_mid_flash(tmp_path):
-    main = threading.get_ident()
+    main, over = threading.get_ident(), threading.Event()
     with serve(macros={0: "EM5", 5: "GH"}, faults=Faults(md_delay=0.05)) as (server, vc):
         def interrupt_after_two_writes():
-            end = time.monotonic() + 5
-            while time.monotonic() < end and server.call(lambda v: v.md_count) < 2:
+            # never after the test: a late SIGINT would stop whichever test runs then
+            while not over.is_set() and server.call(lambda v: v.md_count) < 2:
                 time.sleep(0.002)
-            signal.pthread_kill(main, signal.SIGINT)  # a real SIGINT, as Ctrl-C sends
+            if not over.is_set():
+                signal.pthread_kill(main, signal.SIGINT)  # a real SIGINT, as Ctrl-C sends
 
-        threading.Thread(target=interrupt_after_two_writes, daemon=True).start()
-        with pytest.raises(FlashInterrupted) as caught:
-            run_flash(server, program_of(PROGRAM), tmp_path)
+        interrupter = threading.Thread(target=interrupt_after_two_writes, daemon=True)
+        interrupter.start()
+        try:
+            with pytest.raises(FlashInterrupted) as caught:
+                run_flash(server, program_of(PROGRAM), tmp_path)
+        finally:
+            over.set()
+            interrupter.join()
         assert caught.value.exit_code == EXIT_INTERRUPTED
         text = caught.value.message
         assert "interrupted (Ctrl-C)" in text and "not written:" in text and "MC00" in text
