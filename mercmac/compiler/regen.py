@@ -48,7 +48,7 @@ def _canonical_states(lalr) -> None:
     Here they are numbered breadth-first from the start state, following shifts in
     token-name order, and each state's actions are sorted by token name.
     """
-    table = lalr._parse_table
+    table = lalr.parser.parse_table  # the table lark parses with (LALR_Parser.parser)
     order = sorted(table.start_states.values())
     seen = set(order)
     for state in order:  # grows while it is walked: breadth-first

@@ -82,7 +82,7 @@ def _edges(edges: list[Edge], width: int) -> Iterator[tuple[int, Line]]:
     for edge in edges:
         t = edge.t
         text = f"{edge.wire.source} -> {edge.wire.target} {'ON' if edge.level else 'OFF'}"
-        yield t, one._at(t) + [(f"{'':<{width}}  wire {text}", "cyan")]
+        yield t, one.at(t) + [(f"{'':<{width}}  wire {text}", "cyan")]
 
 
 def _ending(name: str, run, width: int) -> Line:

@@ -55,29 +55,29 @@ def event_line(event) -> Line | None:
     match event:
         case ev.InputChanged(t, n, on):
             name = {5: "joystick", 6: "joystick button"}.get(n, f"button {n}")
-            return _at(t) + [(f"{name} {'pressed' if on else 'released'}", "bold cyan")]
+            return at(t) + [(f"{name} {'pressed' if on else 'released'}", "bold cyan")]
         case ev.OutputsChanged(t, pattern):
-            return _at(t) + [("LEDs ", "")] + lamps(pattern)
+            return at(t) + [("LEDs ", "")] + lamps(pattern)
         case ev.Reported(t, text, where):
-            return _at(t) + [("report ", ""), (text, "bold"), (_where(where), "dim")]
+            return at(t) + [("report ", ""), (text, "bold"), (_where(where), "dim")]
         case ev.HazardFound(t, rule, message, where):
-            return _at(t) + [(f"hazard {rule}: ", "bold red"), (message, "red"), (_where(where), "dim")]
+            return at(t) + [(f"hazard {rule}: ", "bold red"), (message, "red"), (_where(where), "dim")]
         case ev.MoveStarted(t, kind, target, arrival, segments, where):
-            return _at(t) + [(_move(t, kind, target, arrival, segments), "green"),
+            return at(t) + [(_move(t, kind, target, arrival, segments), "green"),
                              (_where(where), "dim")]
         case ev.MoveEnded(t, Ended.ARRIVED, position):
-            return _at(t) + [(f"on target at {position}", "green")]
+            return at(t) + [(f"on target at {position}", "green")]
         case ev.MoveEnded(t, Ended.LIMIT, position):
-            return _at(t) + [(f"stopped by the limit switch at {position}", "bold red")]
+            return at(t) + [(f"stopped by the limit switch at {position}", "bold red")]
         case ev.HomeDefined(t, position, where):
-            return _at(t) + [(f"home defined: position is now {position}", "green"), (_where(where), "dim")]
+            return at(t) + [(f"home defined: position is now {position}", "green"), (_where(where), "dim")]
         case ev.ProgramEnded(t):
-            return _at(t) + [("program ended: back in direct mode", "bold")]
+            return at(t) + [("program ended: back in direct mode", "bold")]
         case ev.FastForwarded(t, t_to, passes, period, loop, shape, _, shift):
             kind = ("identical pass", "identical passes") if not shift else ("pass", "passes")
             moved = (f", each {'+' if shift > 0 else '-'}{plural(abs(shift), 'count')} further"
                      if shift else "")
-            return _at(t) + [(f"fast-forward {plural(passes, *kind)} of {loop.label} "
+            return at(t) + [(f"fast-forward {plural(passes, *kind)} of {loop.label} "
                               f"({format_span(period)}{_emitted(shape)} each{moved}) "
                               f"to {clock(t_to)}", "magenta"), (_where(loop), "dim")]
         case Folded():
@@ -163,9 +163,9 @@ def _fold_lines(fold: Folded, level: int) -> list[tuple[int, Line]]:
             texts, style = [_flow_text(fold, kind is Fold.ENTRY)], "blue"
     if fold.count == 1:
         times = [fold.first_t, fold.last_t] if fold.kind is Fold.POLL else [fold.last_t]
-        return [(t, _at(t) + [(text, style)]) for t, text in zip(times, texts)]
+        return [(t, at(t) + [(text, style)]) for t, text in zip(times, texts)]
     counts = [f"  x{fold.count:,} since {clock(fold.first_t)}", f"  x{fold.count:,}"]
-    return [(fold.last_t, _at(fold.last_t) + [(text + count, style)])
+    return [(fold.last_t, at(fold.last_t) + [(text + count, style)])
             for text, count in zip(texts, counts)]
 
 
@@ -178,7 +178,7 @@ def _polls(folds: list[Folded]) -> list[tuple[int, Line]]:
     slots = ", ".join(dict.fromkeys(slot_name(f.event.slot) for f in polls))
     text = (f"{plural(sum(f.count for f in polls), 'poll')} since "
             f"{clock(min(f.first_t for f in polls))}: {slots} tested and left")
-    return [(t, _at(t) + [(text, "dim blue")])]
+    return [(t, at(t) + [(text, "dim blue")])]
 
 
 def _stretch(folds: list[Folded], level: int) -> list[tuple[int, Line]]:
@@ -189,7 +189,8 @@ def _stretch(folds: list[Folded], level: int) -> list[tuple[int, Line]]:
     return sorted(dated, key=lambda pair: pair[0])
 
 
-def _at(t_us: float) -> Line:
+def at(t_us: float) -> Line:
+    """A timeline line's time column (render/rig.py dates its wires' edges alike)."""
     return [(f"{clock(t_us):>16}  ", "dim")]
 
 
@@ -250,7 +251,7 @@ def ending(run: Run) -> list[Line]:
     """The timeline's last line when the run stopped at --until with the program running."""
     if run.halted:
         return []
-    return _at(run.until_ms * 1000) + [(f"end of the run: {run.machine.chunk.label} "
+    return at(run.until_ms * 1000) + [(f"end of the run: {run.machine.chunk.label} "
                                         "still running", "bold")]
 
 
@@ -278,7 +279,7 @@ def trace(record: Recorder) -> list[Line]:
     """Executed instructions, with the fast-forward jumps between them."""
     skips = [e for e in record.timeline if isinstance(e, ev.FastForwarded)]
     merged = sorted(record.trace + skips, key=lambda e: e.t)  # stable: skips after their RP
-    lines = [_at(e.t) + [(e.text, "")] if isinstance(e, ev.Executed) else event_line(e)
+    lines = [at(e.t) + [(e.text, "")] if isinstance(e, ev.Executed) else event_line(e)
              for e in merged]
     if record.dropped["trace"]:
         lines.append([(f"... {record.dropped['trace']:,} more instructions", "dim")])
@@ -420,4 +421,4 @@ def countdown_status(left_s: float, inputs: list[bool]) -> str:
 
 def reset_line(t_us: float) -> Line:
     """The line `r` leaves in the interactive box's log."""
-    return _at(t_us) + [("reset: power-on again (like RT); held buttons stay held", "bold")]
+    return at(t_us) + [("reset: power-on again (like RT); held buttons stay held", "bold")]

@@ -15,7 +15,7 @@ from mercmac.compiler.program import Program
 from mercmac.errors import signal_of
 from mercmac.rig.model import Rig, Wire
 from mercmac.sim.record import CAP
-from mercmac.sim.rig_ff import JointForward, tell, where
+from mercmac.sim.rig_ff import JointForward
 from mercmac.sim.simulate import DEFAULT_UNTIL_MS, Run, machine_for, schedule
 from mercmac.timespec import Press
 from mercmac.vm import events as ev
@@ -169,7 +169,7 @@ class RigSim:
         for name, m in waiting.items():
             message = m.hazards.add(DEADLOCK, (name,), waits=waits)
             if message is not None:
-                tell(m, ev.HazardFound(t, DEADLOCK, message, where(m)))
+                m.tell(ev.HazardFound(t, DEADLOCK, message, m.last_command()))
 
     def _stuck(self, name: str, m: Machine) -> bool:
         """Whether `m`, with nothing due, waits for good: on an input line no button of the

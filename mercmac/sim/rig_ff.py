@@ -6,10 +6,12 @@ machine runs instant by instant (sim/rig.py) and this module compares the joint 
 
 A joint anchor is an instant after which every axis rests on a whole-count target or moves
 on a profile it keys relative to the time and target, with no trigger pulse on
-and no JT table being made. The joint key there is every machine's state key
-(vm/statekey.py) without position, target and profile (`unshifted`), the profile and the
-trigger relative to the target, its input lines, its next command relative to now, and
-every wire's level. When the key comes back,
+and no JT table being made. The joint key there is every machine's own (Optimiser.joint_key:
+its state key without position, target and profile, the profile and the trigger relative to
+the target, its input lines, its next command relative to now) and every wire's level. The
+machines are read and moved only through their public surface (Machine.skip_passes,
+Optimiser.effects, ...); this module keeps what is about several controllers
+(docs/simulator.md, "Fast-forward"). When the key comes back,
 the rig passed through a pass; when two passes in a row have the same shape (per machine:
 moves, arrivals, reports, output changes relative to the pass's start time and position,
 fastforward.moved_shape) and the same shifts, the next passes are copies, each `period`
@@ -29,15 +31,11 @@ from typing import TYPE_CHECKING
 from mercmac.sim.record import CAP
 from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
-from mercmac.vm.machine import Machine
 
 if TYPE_CHECKING:
     from mercmac.sim.rig import RigSim
 
-INF = math.inf
 SEEN_LIMIT = 4096  # joint keys remembered; a rig whose state never repeats forgets them
-_BLOCK = Machine.STATE_KEY.index("block")
-_COUNTERS = Machine.STATE_KEY.index("counters")
 
 
 @dataclass(slots=True)
@@ -70,7 +68,7 @@ class JointForward:
             return
         visit = JointVisit(t, tuple(m.axis.target for m in self.machines), self._logged(),
                            len(self.sim.edges) + self.sim.edges_dropped, self._external(),
-                           tuple(_counters(m) for m in self.machines))
+                           tuple(m.rp_counters() for m in self.machines))
         previous = self.seen.get(key)
         if len(self.seen) >= SEEN_LIMIT:
             self.seen.clear()
@@ -98,7 +96,7 @@ class JointForward:
     def _key(self, t: int) -> tuple | None:
         parts = []
         for m in self.machines:
-            part = _machine_key(m, t)
+            part = m.optimiser.joint_key(t)
             if part is None:
                 return None
             parts.append(part)
@@ -106,7 +104,7 @@ class JointForward:
         return tuple(parts)
 
     def _logged(self) -> tuple[int, ...]:
-        return tuple(m.optimiser.log_base + len(m.optimiser.log) for m in self.machines)
+        return tuple(m.optimiser.logged() for m in self.machines)
 
     def _external(self) -> float:
         """The next change from outside: a scheduled button or the joystick."""
@@ -118,11 +116,10 @@ class JointForward:
         (the wires' input changes are left out: the joint key holds the lines)."""
         shapes = []
         for i, m in enumerate(self.machines):
-            log, base = m.optimiser.log, m.optimiser.log_base
-            if previous.logged[i] < base:
+            effects = m.optimiser.effects(previous.logged[i], visit.logged[i])
+            if effects is None:
                 return None  # the log was cut since: the pass is not known whole
-            events = [e for e in log[previous.logged[i] - base:visit.logged[i] - base]
-                      if type(e) is not ev.InputChanged]
+            events = [e for e in effects if type(e) is not ev.InputChanged]
             shape = ff.moved_shape(events, previous.t, previous.positions[i])
             if shape is None:
                 return None
@@ -137,9 +134,8 @@ class JointForward:
                 break
             shape = visit.shapes[i]
             if not ff.plain(shape):
-                now = ff.Visit(None, visit.t, 0, 0, 0, None, (), visit.positions[i],
-                               visit.deltas[i], shape)
-                fit = ff.shifted_passes(now, period, fit, *m.optimiser.boundaries())
+                now = ff.Pass(visit.t, visit.positions[i], visit.deltas[i], shape)
+                fit = m.optimiser.shifted_passes(now, period, fit)
         return fit
 
     # ------------------------------------------------------------ the skip
@@ -147,15 +143,13 @@ class JointForward:
               passes: int) -> None:
         span = passes * period
         for i, m in enumerate(self.machines):
-            _shift_machine(m, span, visit.deltas[i] * passes, visit.spent[i], passes)
-            if m.chunk is not None:  # one that runs nothing did nothing in the passes
-                tell(m, ev.FastForwarded(visit.t, visit.t + span, passes, period, _place(m),
-                                          visit.shapes[i], visit.positions[i], visit.deltas[i]))
+            m.skip_passes(visit.t, passes, period, visit.shapes[i], visit.positions[i],
+                          visit.deltas[i], visit.spent[i])
         self._repeat_edges(previous, visit, period, passes)
         after = JointVisit(visit.t + span,
                            tuple(p + d * passes for p, d in zip(visit.positions, visit.deltas)),
                            self._logged(), len(self.sim.edges) + self.sim.edges_dropped,
-                           visit.external, tuple(_counters(m) for m in self.machines),
+                           visit.external, tuple(m.rp_counters() for m in self.machines),
                            visit.shapes, visit.deltas, visit.spent)
         self.seen[key] = after
 
@@ -178,41 +172,6 @@ class JointForward:
                 return
 
 
-def _machine_key(m: Machine, t: int) -> tuple | None:
-    """One machine's part of the joint key, its position, target, profile and trigger relative
-    to the target and to t (as its own fast-forward keys them, vm/optimiser.py); None when a
-    pulse is on, a JT table is being made, or the axis rests off a whole count or moves on a
-    profile it cannot key."""
-    if m.table_done != INF or m.outputs.pulse_until > t:
-        return None
-    axis = m.axis
-    motion = ()
-    if axis.segs or axis.stalled:
-        relative = axis.relative(t)
-        if relative is None:
-            return None
-        motion = relative, axis.final - axis.target
-    elif axis.final != axis.target:
-        return None
-    trigger = m.trigger.relative(axis.target)
-    if m.chunk is None:  # nothing runs: only its axis and outputs go on (a joystick)
-        return ("halted", axis.unshifted(axis.state_key()), motion, trigger,
-                m.outputs.state_key(), m.deflection, tuple(m.inputs.state))
-    key = list(m._state_key(None))
-    key[_COUNTERS] = tuple(sorted(_counters(m)))  # which RPs count; by how much: _spent
-    block = m.block
-    if block is not None:  # when it began matters only for the first cycle after
-        key[_BLOCK] = (block.wait, block.arg, min(t - block.began, m.clock.cycle))
-    running = m.chunk is not None and block is None
-    return (m.unshifted(tuple(key)), motion, trigger, tuple(m.inputs.state),
-            m.wake - t if running else None)
-
-
-def _counters(m: Machine) -> dict[tuple[int, int], int]:
-    """The machine's RP counters by (slot, RP's place)."""
-    return {(slot, ip): c for slot, cs in m.counters.items() for ip, c in cs.items()}
-
-
 def _spent(before: dict, after: dict) -> dict | None:
     """How much a pass counted each RP down; None if one counted up (a loop restarted)."""
     spent = {place: before[place] - c for place, c in after.items()}
@@ -229,37 +188,3 @@ def _left(visit: JointVisit) -> int | float:
             if d:
                 left = min(left, (counters[place] - 1) // d)
     return left
-
-
-def _shift_machine(m: Machine, span: int, moved: int, spent: dict, passes: int) -> None:
-    """Everything of `m` that is a time moves on by `span` us; its axis by `moved` counts; its
-    RP counters down as the skipped passes would have counted them."""
-    for (slot, ip), d in spent.items():
-        m.counters[slot][ip] -= d * passes
-    m.clock.now += span
-    m.wake += span
-    if m.block is not None:
-        m.block = m.block._replace(began=m.block.began + span)
-    m.axis.translate(span, moved)  # at rest or on its way, as the optimiser's jump moves it
-    m.trigger.translate(span, moved)
-
-
-def where(m: Machine) -> ev.Where | None:
-    """The command `m` ran last (a blocked machine: its wait), as events name a place."""
-    chunk, ip = m.chunk, m.ip - 1
-    if chunk is None or not 0 <= ip < len(chunk.code):
-        return None
-    return ev.Where(chunk.label, chunk.slot, ip, chunk.spans[ip])
-
-
-def _place(m: Machine) -> ev.Where:
-    """Where a running machine stands in its pass: the command it ran last, or its next."""
-    chunk = m.chunk
-    ip = min(max(m.ip - 1, 0), len(chunk.code) - 1)
-    return ev.Where(chunk.label, chunk.slot, ip, chunk.spans[ip])
-
-
-def tell(m: Machine, event: object) -> None:
-    """An event of the rig's about one machine, heard by that machine's listeners."""
-    for listener in m.listeners:
-        listener(event)

@@ -51,7 +51,7 @@ def default_path(port: str, address: int, when: _dt.datetime | None = None) -> P
     """A timestamped file in the per-user data directory: never overwrites an older backup."""
     when = when or _dt.datetime.now()
     folder = data_dir() / "backups"
-    stem = f"{_port_tag(port)}-addr{address}-{when.strftime('%Y%m%d-%H%M%S')}"
+    stem = f"{port_tag(port)}-addr{address}-{when.strftime('%Y%m%d-%H%M%S')}"
     path, n = folder / f"{stem}.mcm", 1
     while path.exists():
         n += 1
@@ -105,7 +105,7 @@ def save(text: str, path: Path) -> Path:
     return path
 
 
-def _port_tag(port: str) -> str:
+def port_tag(port: str) -> str:
     """'/dev/ttyUSB0' -> 'ttyUSB0', '/dev/pts/3' -> 'pts-3', 'socket://lab:4001' -> 'lab-4001'."""
     tail = port.split("://", 1)[-1]
     tail = re.sub(r"^(/dev/|\\\\\.\\)", "", tail)

@@ -337,7 +337,7 @@ def _said(value, hint) -> str:
 
 
 def _new_path(when: _dt.datetime, port: str, address: int) -> Path:
-    stem = f"{when.strftime('%Y%m%d-%H%M%S-%f')}-{backup._port_tag(port)}-addr{address}"
+    stem = f"{when.strftime('%Y%m%d-%H%M%S-%f')}-{backup.port_tag(port)}-addr{address}"
     path, n = folder() / f"{stem}.json", 1
     while path.exists():
         n += 1

@@ -383,6 +383,16 @@ class Visit:
     flows: int = 0  # macro entries and exits so far, those of skipped passes too
 
 
+class Pass(NamedTuple):
+    """What shifted_passes reads of the pass that ended at an anchor (a Visit has it too; a
+    rig's joint skip, sim/rig_ff.py, has no Visit of its own)."""
+
+    wake: int  # when the pass ended, us
+    position: int  # the target there
+    delta: int  # how much further on it ended than it began
+    moved: tuple  # its moved_shape
+
+
 def same_pass(previous: Visit, now: Visit) -> bool:
     """True when the pass from `previous` to `now` will repeat exactly.
 
@@ -417,7 +427,7 @@ def same_shifted_pass(previous: Visit, now: Visit) -> bool:
             and now.delta == previous.delta and now.moved == previous.moved)
 
 
-def shifted_passes(now: Visit, period: int, fit: int, bounds: tuple, hard: tuple | None,
+def shifted_passes(now: Visit | Pass, period: int, fit: int, bounds: tuple, hard: tuple | None,
                    reference: float | None = None, grid: int = 0) -> int:
     """How many of `fit` passes shifted by now.delta each stay clear of every boundary.
 

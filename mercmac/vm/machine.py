@@ -772,12 +772,9 @@ class Machine:
         """Skip the passes the optimiser found repeating (vm/optimiser.py), each `jump.shift`
         further on than the last: the clock, the position and the target jump exactly."""
         start = self.wake
-        self.wake += jump.passes * jump.period
         if jump.own is not None:
             self.counters[self.chunk.slot][jump.own] -= jump.passes
-        # the axis at rest or on its way moves on by whole counts and microseconds
-        self.axis.translate(jump.passes * jump.period, jump.passes * jump.shift)
-        self.trigger.translate(jump.passes * jump.period, jump.passes * jump.shift)
+        self._move_on(jump.passes * jump.period, jump.passes * jump.shift)
         if self.on_report is not None:  # the host hears every report (mercmac emulate)
             for r in ff.expand(jump.shape, start, jump.period, jump.passes, ff.REPORT,
                                jump.position, jump.shift):
@@ -786,6 +783,47 @@ class Machine:
                                     self._where_anchor(jump.anchor), jump.shape,
                                     jump.position, jump.shift, self.clock.now,
                                     jump.counted))
+
+    def skip_passes(self, t: int, passes: int, period: int, shape: tuple, position: int,
+                    shift: int, spent: Mapping[tuple[int, int], int]) -> None:
+        """Skip `passes` passes that a rig found repeating jointly from the instant t
+        (sim/rig_ff.py), each `period` us long and `shift` counts further on than the last,
+        each counting the RP at (slot, ip) down by spent[(slot, ip)]. A rig skips between two
+        instants, so the clock and a wait's start move on too; a jump of its own (_jump) skips
+        from a loop anchor, before the clock reaches the next command."""
+        span = passes * period
+        for (slot, ip), d in spent.items():
+            self.counters[slot][ip] -= d * passes
+        self.clock.now += span
+        if self.block is not None:  # how long it has waited stays the same
+            self.block = self.block._replace(began=self.block.began + span)
+        self._move_on(span, shift * passes)
+        if self.chunk is not None:  # one that runs nothing did nothing in the passes
+            self.tell(ev.FastForwarded(t, t + span, passes, period, self._place(), shape,
+                                       position, shift))
+
+    def _move_on(self, span: int, moved: int) -> None:
+        """What every skip moves on: the next command by `span` us; the axis, at rest or on
+        its way, and the trigger by `span` us and `moved` counts, exactly (Axis.translate)."""
+        self.wake += span
+        self.axis.translate(span, moved)
+        self.trigger.translate(span, moved)
+
+    def rp_counters(self) -> dict[tuple[int, int], int]:
+        """The RP counters by (slot, RP's place): what each loop has left to count down."""
+        return {(slot, ip): c for slot, cs in self.counters.items() for ip, c in cs.items()}
+
+    def _joint_state(self, t: int) -> tuple:
+        """The state key as a rig compares it at the instant t (Optimiser.joint_key): which RPs
+        count, not by how much (the rig counts them down itself, sim/rig_ff.py), and a wait
+        by how long it has waited, up to a cycle (its start matters only to the first cycle
+        after it). Machine is the one module that knows where fields stand in its key."""
+        key = list(self._state_key(None))
+        key[_COUNTERS] = tuple(sorted(self.rp_counters()))
+        block = self.block
+        if block is not None:
+            key[_BLOCK] = (block.wait, block.arg, min(t - block.began, self.clock.cycle))
+        return tuple(key)
 
     def _busy_loop(self, anchor: Anchor) -> None:
         """The optimiser found a long loop without a wait at `anchor`."""
@@ -808,6 +846,15 @@ class Machine:
         self.shown = 0
         self.mover = None
         self.optimiser.code_changed()
+
+    def last_command(self) -> ev.Where | None:
+        """The command the machine ran last (a blocked one: its wait), as events name a place;
+        None when it runs nothing."""
+        return self._where(self.ip - 1)
+
+    def _place(self) -> ev.Where:
+        """Where a running machine stands in its pass: the command it ran last, or its next."""
+        return self._where(min(max(self.ip - 1, 0), len(self.chunk.code) - 1))
 
     def _where(self, ip: int) -> ev.Where | None:
         chunk = self.chunk
@@ -832,5 +879,15 @@ class Machine:
 
     def _emit(self, event: object) -> None:
         self.optimiser.emitted(event)
+        self.tell(event)
+
+    def tell(self, event: object) -> None:
+        """Have the listeners hear `event`. From outside (a rig's skip or deadlock, sim/rig.py)
+        the optimiser does not log it: it is no effect of one of this machine's passes."""
         for listener in self.listeners:
             listener(event)
+
+
+# where the fields that a rig compares its own way stand in the state key (_joint_state)
+_COUNTERS = Machine.STATE_KEY.index("counters")
+_BLOCK = Machine.STATE_KEY.index("block")

@@ -177,6 +177,50 @@ class Optimiser:
         """A trigger pulse: its time comes from where the profile reaches a position."""
         self.log.append(Note.FLOATS)
 
+    # ------------------------------------------------------------ for a rig's joint skip
+    def logged(self) -> int:
+        """Effects logged so far: a mark in the effect log (Visit.logged, effects)."""
+        return self.log_base + len(self.log)
+
+    def effects(self, start: int, end: int) -> list | None:
+        """The effects logged between two marks (logged()); None once the log was cut past
+        `start` (LOG_LIMIT): the pass is not known whole."""
+        if start < self.log_base:
+            return None
+        return self.log[start - self.log_base:end - self.log_base]
+
+    def joint_key(self, t: int) -> tuple | None:
+        """The machine's part of a rig's joint key at the instant t (sim/rig_ff.py): its shift
+        key (_shift_key) over the state a rig compares (Machine._joint_state), its input lines
+        (the wires' levels) and its next command relative to t. None when a trigger pulse is
+        on or a JT table is being made (each ends at a time of its own), or _shift_key has
+        none (the axis rests off a whole count, or moves on a profile it cannot key); see
+        (docs/simulator.md, "Fast-forward")."""
+        m = self.machine
+        if m.table_done != INF or m.outputs.pulse_until > t:
+            return None
+        if m.chunk is None:
+            return self._halted_key(t)
+        key, _ = self._shift_key(self._key(None, at=t, state=m._joint_state(t)))
+        if key is None:
+            return None
+        return key, tuple(m.inputs.state), m.wake - t if m.block is None else None
+
+    def _halted_key(self, t: int) -> tuple | None:
+        """A machine that runs nothing: only its axis and outputs go on (a joystick)."""
+        m, axis = self.machine, self.machine.axis
+        motion = ()
+        if axis.segs or axis.stalled:
+            relative = axis.relative(t)
+            if relative is None:
+                return None
+            motion = relative, axis.final - axis.target
+        elif axis.final != axis.target:
+            return None
+        return ("halted", axis.unshifted(axis.state_key()), motion,
+                m.trigger.relative(axis.target), m.outputs.state_key(), m.deflection,
+                tuple(m.inputs.state))
+
     # ------------------------------------------------------------ at a loop anchor
     def _arrive(self, anchor: Anchor, own: int | None, remaining: float) -> None:
         """A loop came round: report a busy loop, skip identical passes (fastforward.py)."""
@@ -207,12 +251,17 @@ class Optimiser:
         # the running profile's arrival is the pass's own (its shape has it; its limit hit is a
         # boundary, shifted_passes): only other hardware events bound the skip
         fit = ff.skippable(previous, visit, self._bound(axis=False), remaining)
-        passes = ff.shifted_passes(visit, period, fit, *self.boundaries())
+        passes = self.shifted_passes(visit, period, fit)
         if passes < fit:  # a boundary, not the counter, ends it: enclosing passes differ
             self.log.append(Note.UNSHIFTABLE)
         if passes > 0:
             self._jump(Jump(anchor, own, passes, period, visit.moved, visit.position,
                             visit.delta, self._counted(previous, visit)), visit)
+
+    def shifted_passes(self, now: ff.Pass | Visit, period: int, fit: int) -> int:
+        """How many of `fit` passes, each `period` us and `now.delta` counts on from the one
+        that ended at `now`, stay clear of this machine's boundaries (ff.shifted_passes)."""
+        return ff.shifted_passes(now, period, fit, *self.boundaries())
 
     def boundaries(self) -> tuple:
         """What bounds a shifted skip here (fastforward.shifted_passes): the soft range, the
@@ -231,7 +280,7 @@ class Optimiser:
         key = self._key(jump.own, at=now)  # (moved on: as fresh as the pass it copies)
         skey, position = self._shift_key(key)
         self.anchors.visits[jump.anchor] = Visit(key, self.machine.wake, self.inputs, self.waits,
-                                         self.log_base + len(self.log), visit.shape,
+                                         self.logged(), visit.shape,
                                          skey, position, visit.delta, visit.moved, now,
                                          True, self.flows)
 
@@ -277,7 +326,7 @@ class Optimiser:
             moved = ff.moved_shape(self.log[previous.logged - self.log_base:],
                                    previous.wake, previous.position)
         return Visit(key, self.machine.wake, self.inputs, self.waits,
-                     self.log_base + len(self.log), pass_shape, skey, position, delta, moved,
+                     self.logged(), pass_shape, skey, position, delta, moved,
                      self.machine.clock.now, fresh, self.flows)
 
     def _fresh(self, previous: Visit | None) -> bool:
@@ -286,12 +335,13 @@ class Optimiser:
         return plan is not None and (previous is None or plan.t > previous.t)
 
     def _key(self, own: int | None, previous: Visit | None = None, fresh: bool = True,
-             at: int | None = None) -> tuple | None:
-        """The machine's state key (Machine.STATE_KEY) at `at` (now); while the axis moves, with
-        its profile relative to that time and the target (Axis.relative), or None if it has
-        none. Only a pass that planned its profile anew, after one that did too, can repeat
-        one: a profile that ran at the previous visit is not at the same phase now. (So a
-        polling loop that waits for a long move is spared the key at every pass.)"""
+             at: int | None = None, state: tuple | None = None) -> tuple | None:
+        """The machine's state key (Machine.STATE_KEY; `state`, a rig's, if given) at `at`
+        (now); while the axis moves, with its profile relative to that time and the target
+        (Axis.relative), or None if it has none. Only a pass that planned its profile anew,
+        after one that did too, can repeat one: a profile that ran at the previous visit is
+        not at the same phase now. (So a polling loop that waits for a long move is spared
+        the key at every pass.)"""
         m, axis = self.machine, self.machine.axis
         if axis.segs or axis.stalled:
             if previous is not None and not (previous.fresh and fresh):
@@ -299,9 +349,9 @@ class Optimiser:
             relative = axis.relative(m.clock.now if at is None else at)
             if relative is None:
                 return None
-            return (m.unshifted(m._state_key(own)), relative, axis.target, axis.final,
-                    m.trigger.next_at)
-        return m._state_key(own)
+            return (m.unshifted(m._state_key(own) if state is None else state), relative,
+                    axis.target, axis.final, m.trigger.next_at)
+        return m._state_key(own) if state is None else state
 
     def _shift_key(self, key: tuple | None) -> tuple[tuple | None, int]:
         """The state key without the axis's position and target, and the target; (None, 0)

@@ -113,3 +113,79 @@ def test_check_imports_nothing_heavy(args):
     heavy = [m for m in probe["modules"]
              if any(m == h or m.startswith(h + ".") for h in HEAVY) or "plot" in m.split(".")[-1]]
     assert heavy == []
+
+
+# -- one surface: no private members from outside ---------------------------------------
+# The machine has one surface for whoever skips, keys and reports (the optimiser, a rig's
+# joint skip, plot, VCD): outside mercmac/vm/ no module reads or writes another object's
+# `_private` member (docs/architecture.md, "One way down"), nor reads a machine's state key
+# by position, which would break silently when a field is added to it (vm/statekey.py).
+
+# A namedtuple's own methods carry an underscore only so that they cannot clash with a field:
+# they are its public API (the `collections` documentation), not private members.
+NAMEDTUPLE_API = {"_replace", "_make", "_asdict", "_fields", "_field_defaults"}
+# Foreign libraries that offer no public way to what is needed: (file, attribute) -> why.
+FOREIGN = {
+    ("mercmac/compiler/parse.py", "_mres"): "lark's scanner keeps its one compiled regex there",
+    ("mercmac/lsp/server.py", "_send_response"): "pygls cannot answer a request it refused",
+}
+OUTSIDE_VM = [p for p in MODULES if "vm" not in p.relative_to(PACKAGE).parts[:1]]
+
+
+def _private_uses(tree: ast.AST) -> list[tuple[int, str]]:
+    """(line, text) for every `x._name` whose `x` is not self or cls (a dunder is public)."""
+    found = []
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Attribute) and node.attr.startswith("_")
+                and not node.attr.startswith("__") and node.attr not in NAMEDTUPLE_API
+                and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"))):
+            found.append((node.lineno, ast.unparse(node)))
+    return found
+
+
+def _state_key_by_position(tree: ast.AST) -> list[tuple[int, str]]:
+    """(line, text) for `X.STATE_KEY[...]`, `X.STATE_KEY.index(...)` and a subscript of a
+    name bound to either: a state key read by where a field stands in it."""
+    found, bound = [], set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Assign) and _names_state_key(node.value):
+            bound |= {t.id for t in node.targets if isinstance(t, ast.Name)}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Subscript) and (
+                _names_state_key(node.value)
+                or (isinstance(node.value, ast.Name) and node.value.id in bound)):
+            found.append((node.lineno, ast.unparse(node)))
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+              and node.func.attr == "index" and _names_state_key(node.func.value)):
+            found.append((node.lineno, ast.unparse(node)))
+    return found
+
+
+def _names_state_key(node: ast.AST) -> bool:
+    return ((isinstance(node, ast.Attribute) and node.attr == "STATE_KEY")
+            or (isinstance(node, ast.Name) and node.id == "STATE_KEY"))
+
+
+def test_the_walk_sees_private_uses_and_state_key_positions():
+    tree = ast.parse("m._jump(j)\nself._x = 1\nk[Machine.STATE_KEY.index('block')]\n"
+                     "K = Machine.STATE_KEY\nK[3]\np._replace(a=1)\nx.__class__\n")
+    assert [t for _, t in _private_uses(tree)] == ["m._jump"]
+    assert sorted(t for _, t in _state_key_by_position(tree)) == [
+        "K[3]", "Machine.STATE_KEY.index('block')"]
+
+
+@pytest.mark.parametrize("path", OUTSIDE_VM, ids=lambda p: _module_name(p))
+def test_no_private_member_is_used_from_outside(path):
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    where = str(path.relative_to(ROOT).as_posix())
+    found = [f"{where}:{line}: {text}" for line, text in _private_uses(tree)
+             if (where, text.rpartition(".")[2]) not in FOREIGN]
+    found += [f"{where}:{line}: {text} (by position)"
+              for line, text in _state_key_by_position(tree)]
+    assert found == [], "use the owner's public surface:\n" + "\n".join(found)
+
+
+def test_every_foreign_exception_is_still_needed():
+    for (file, attr), why in FOREIGN.items():
+        uses = _private_uses(ast.parse((ROOT / file).read_text(encoding="utf-8")))
+        assert any(text.endswith("." + attr) for _, text in uses), f"{file}: {attr} ({why}) is gone"
