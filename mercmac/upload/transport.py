@@ -130,13 +130,14 @@ class Transport:
         limit = self.timing.timeout if timeout is None else timeout
         started = quiet_since = time.monotonic()
         hard_stop = min(started + self.timing.budget(self.baud), deadline or math.inf)
+        came = False  # a byte in this read: only then can the hard stop mean a flood
         while True:
             if self._reports:
                 return self._reports.pop(0)
             data = self._read_some()
             now = time.monotonic()
             if data:
-                quiet_since = now
+                came, quiet_since = True, now
                 try:
                     self._reports.extend(self._splitter.feed(data))
                 except ProtocolError as e:
@@ -145,7 +146,10 @@ class Transport:
                     continue
             if now - quiet_since >= limit:
                 raise ReadTimeout(f"no complete reply within {limit:g} s", self._splitter.pending())
-            if now >= hard_stop:  # bytes kept coming: never an ETX, or reports the caller skips
+            # bytes kept coming: never an ETX, or reports the caller skips. Not after silence
+            # alone: a process stalled past the stop (a loaded machine, a laptop's sleep) saw
+            # nothing come, and that is the silence above, not a flood
+            if came and now >= hard_stop:
                 pending = self._splitter.pending()
                 what = f"{now - started:.1f} s of bytes without an end of report (ETX)" if pending \
                     else "replies kept coming, none of them the answer"
