@@ -348,9 +348,8 @@ def pull_rig(port: str, *, baud: int = DEFAULT_BAUD, timing: Timing = Timing(),
     Refused when none answers, or two answer at one address (survey.Found.shared)."""
     with open_controller(port, 0, baud=baud, timing=timing) as first:
         t = first.transport
-        t.timing = timing.searching
-        found = [f for f in survey.scan(t, stop=True, on_address=on_address) if f.status]
-        t.timing = timing
+        with t.per_address():
+            found = [f for f in survey.scan(t, stop=True, on_address=on_address) if f.status]
         if not found:
             raise Refused(f"no controller answers at addresses 0-15 on {port}",
                           hint=f"check power and cable, and that DIP switches 5-6 set the "

@@ -146,14 +146,12 @@ def find_address(transport: Transport,
     except ControllerError:
         return 0  # an answer at 0, even a garbled one: 0, as without the search (identify says why)
     timing = transport.timing
-    transport.timing = timing.searching
     try:
-        found = scan(transport, range(1, 16), on_address=on_address)
+        with transport.per_address():
+            found = scan(transport, range(1, 16), on_address=on_address)
     except UploadError as e:
         raise Refused(f"the port failed while looking for the controller: {e}; nothing was written",
                       hint="check the cable and that the USB adapter is still there") from None
-    finally:
-        transport.timing = timing
     answering = [f for f in found if f.status]
     if len(answering) == 1:
         return answering[0].address

@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import math
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
-from typing import Callable
+from typing import Callable, Iterator
 
 from mercmac.upload.protocol import ProtocolError, ReportSplitter
 
@@ -64,11 +65,6 @@ class Timing:
         search = timeout if searching_too else min(timeout, SEARCH_TIMEOUT)
         return cls(timeout=timeout, settle=min(0.25, timeout), search=search)
 
-    @property
-    def searching(self) -> "Timing":
-        """This timing while looking for controllers: each reply waited for `search` s."""
-        return replace(self, timeout=self.search)
-
     def budget(self, baud: int, size: int = LONGEST_REPLY) -> float:
         """Longest time one exchange may take: a timeout plus `size` bytes at `baud`."""
         return self.timeout + size * 10 / max(baud, 300) + 2.0
@@ -88,6 +84,17 @@ class Transport:
 
     def __enter__(self) -> "Transport":
         return self
+
+    @contextmanager
+    def per_address(self) -> Iterator[None]:
+        """Inside, each reply is waited for `timing.search` s: a search of addresses, most of
+        them empty (scan in pull --rig, find_address)."""
+        timing = self.timing
+        self.timing = replace(timing, timeout=timing.search)
+        try:
+            yield
+        finally:
+            self.timing = timing
 
     def __exit__(self, *exc) -> None:
         self.close()
