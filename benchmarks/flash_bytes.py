@@ -116,7 +116,7 @@ def identified(model: str, firmware: str = "2.30") -> int:
 def rig_main(path: Path = RASTER, framing: str = "etx-per-line") -> float:
     """A full flash of the rig PATH to an empty chain: bytes against the minimum; the ratio."""
     from mercmac.emulator.chain import Chain
-    from mercmac.rig.accept import accept
+    from mercmac.rig.open import accept
     from mercmac.upload.protocol import select
     from mercmac.upload.rig import flash_rig
 

@@ -151,27 +151,27 @@ def presses_at_one_instant(count: int) -> float:
     from mercmac.compiler import compile_source
     from mercmac.source import Source
     from mercmac.timespec import Press
-    from mercmac.sim.simulate import simulate
+    from mercmac.sim.simulate import simulate_program
 
     program = compile_source(Source("presses.mcm", "autostart {\n  every 20ms { TC 1 }\n}\n")).program
     presses = [Press((1, 2, 3, 4), 1000, 1001 + i % 2) for i in range(count)]
     start = time.perf_counter()
-    simulate(program, presses=presses, until_ms=3000)
+    simulate_program(program, presses=presses, until_ms=3000)
     return time.perf_counter() - start
 
 
 def raster_stepped(until_ms: int) -> float:
     """Wall seconds of the raster rig stepped instant by instant (no joint fast-forward)."""
-    from mercmac.rig.accept import accept
-    from mercmac.sim.rig import simulate_rig
+    from mercmac.rig.open import accept
+    from mercmac.sim.simulate import simulate
     from mercmac.timespec import parse_buttons
 
     accepted = accept(str(RASTER))
     rig = accepted.rig
     programs = {name: c.program for name, c in accepted.programs.items()}
     start = time.perf_counter()
-    simulate_rig(rig, programs, presses={"x": parse_buttons("1@0-100ms")}, until_ms=until_ms,
-                 fast_forward=False)
+    simulate(rig, programs, presses={"x": parse_buttons("1@0-100ms")}, until_ms=until_ms,
+                 fast_forward="off")
     return time.perf_counter() - start
 
 

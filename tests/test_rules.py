@@ -12,7 +12,7 @@ from helpers.cli import cli
 from helpers.compiling import program_of
 from helpers.paths import PACKAGE, ROOT
 from mercmac import diagnostics
-from mercmac.sim.simulate import simulate
+from mercmac.sim.simulate import simulate_program
 from mercmac.vm import hazards
 from mercmac.vm.models import Options
 
@@ -33,7 +33,7 @@ HAZARDS = [
 
 @pytest.mark.parametrize("name,text,options", HAZARDS, ids=[h[0] for h in HAZARDS])
 def test_hazard_is_found(name, text, options):
-    run = simulate(program_of(text), until_ms=5000, options=Options(**options))
+    run = simulate_program(program_of(text), until_ms=5000, options=Options(**options))
     assert name in [h.rule for h in run.record.hazards]
 
 

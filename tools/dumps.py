@@ -18,6 +18,8 @@ from __future__ import annotations
 import argparse
 import os
 import random
+import re
+import shutil
 import tempfile
 import sys
 from pathlib import Path
@@ -163,7 +165,7 @@ class Dumper:
         if views:
             self.cli(f"{name}.v", base + ["-v"])
             self.cli(f"{name}.vv", base + ["-vv"])
-        self._written(f"{name}.vcd", base + ["--vcd"])
+        self._written(f"{name}.vcd", base + ["--vcd-limit", "20", "--vcd"])
         if plot and self.plotted < PLOTTED:
             self.plotted += 1
             for kind in ("svg", "html"):
@@ -174,8 +176,13 @@ class Dumper:
         folder (the name shows in messages), then kept as NAME."""
         kind = name.rsplit(".", 1)[1]
         self.cli(f"{name}-run", [*args, f"out.{kind}"])
-        if os.path.exists(f"out.{kind}"):
-            os.replace(f"out.{kind}", self.out / name)
+        if not os.path.exists(f"out.{kind}"):
+            return
+        if kind in ("svg", "html"):  # matplotlib's clip-path ids differ from run to run
+            text = Path(f"out.{kind}").read_text(encoding="utf-8")
+            Path(f"out.{kind}").write_text(re.sub(r"\bp[0-9a-f]{10}\b", "pID", text),
+                                          encoding="utf-8")
+        os.replace(f"out.{kind}", self.out / name)
 
     def describe(self, name: str, file: str) -> None:
         for fmt in ("text", "markdown", "json"):
@@ -198,7 +205,10 @@ def main() -> None:
     os.environ.setdefault("COLUMNS", "120")
     d = Dumper(out)
     rnd = random.Random(2711)
-    examples = sorted((EXAMPLES / "macros").glob("*.mcm"))
+    examples = work / "examples"  # the bundled ones, copied: their paths show in messages
+    shutil.rmtree(examples, ignore_errors=True)
+    shutil.copytree(EXAMPLES, examples)
+    examples = sorted((examples / "macros").glob("*.mcm"))
     for path in examples:
         stem = path.stem
         d.describe(f"ex-{stem}", str(path))
@@ -210,15 +220,15 @@ def main() -> None:
         d.sim(f"ex-{stem}.trace", str(path), ["--buttons", SCRIPTS[2], "--until", "300ms",
                                              "--trace"], views=False)
         d.sim(f"ex-{stem}.long", str(path), ["--buttons", "1@0", "--until", LONG], views=False)
-    for scenario in sorted((EXAMPLES / "scenarios").glob("*.toml")):
-        program = EXAMPLES / "macros" / (scenario.name.split(".")[0] + ".mcm")
+    for scenario in sorted((work / "examples" / "scenarios").glob("*.toml")):
+        program = work / "examples" / "macros" / (scenario.name.split(".")[0] + ".mcm")
         d.sim(f"scenario-{scenario.stem}", str(program), ["--scenario", str(scenario)],
               views=False)
     failing = work / "failing.toml"
     failing.write_text('until = "2s"\n[[step]]\nat = "0ms"\npress = [3]\n'
                        '[[step]]\nat = "300ms"\nrelease = [3]\n'
                        '[[expect]]\nat = "1s"\noutputs = 15\n', encoding="utf-8")
-    d.sim("scenario-failing", str(EXAMPLES / "macros" / "manual-example4-four-modes.mcm"),
+    d.sim("scenario-failing", str(work / "examples" / "macros" / "manual-example4-four-modes.mcm"),
           ["--scenario", str(failing)], views=False)
     for name, text in LOOPS.items():
         path = work / f"{name}.mcm"
@@ -235,7 +245,7 @@ def main() -> None:
         d.sim(f"random{i:03}", str(path), ["--buttons", script, "--until", until],
               plot=i % 10 == 0)
         d.describe(f"random{i:03}", str(path))
-    raster = EXAMPLES / "rigs" / "raster" / "raster.rig.toml"
+    raster = work / "examples" / "rigs" / "raster" / "raster.rig.toml"
     for until in ("12s", "1h"):
         d.sim(f"rig-raster.{until}", str(raster), ["--buttons", "x:1@0-100ms", "--until", until],
               plot=until == "12s", views=until == "12s")

@@ -136,7 +136,7 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
         results, found = [], []
         for f in paths:
             try:
-                checked = _check_file(f, chosen, fixes)
+                checked, unread = _check_file(f, chosen, fixes)
             except OSError as e:
                 from mercmac.names import printable
                 from mercmac.outfile import reason
@@ -146,7 +146,7 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
                 continue
             results += [findings.compilation for findings in checked]
             found += [d for findings in checked for d in findings.diagnostics]
-            unreadable += _programs_unread(f, checked)
+            unreadable += unread
         if not results:
             return EXIT_USAGE
         if fixes is not None:
@@ -193,10 +193,12 @@ def _fixes(files: tuple[str, ...], fix: bool, diff: bool):
     return Fixes(diff)
 
 
-def _check_file(path: str, chosen, fixes=None) -> list:
-    """What `check` reports on one file, as Findings per file checked: the language server's
-    check (mercmac.compiler.checking), after the file is fixed when `fixes` (--fix, --diff);
-    for a rig file its own findings and its programs' (mercmac.rig.checks)."""
+def _check_file(path: str, chosen, fixes=None) -> tuple[list, int]:
+    """What `check` reports on one file, as Findings per file checked, and how many programs
+    it names could not be read (each makes the exit code 2): the language server's check
+    (mercmac.compiler.checking), after the file is fixed when `fixes` (--fix, --diff); for a
+    rig file its own findings and its programs' (mercmac.rig.open); OSError when it cannot
+    be read."""
     from mercmac.compiler import checking
     from mercmac.errors import SettingsError
     from mercmac.names import printable
@@ -205,33 +207,28 @@ def _check_file(path: str, chosen, fixes=None) -> list:
     try:
         if is_rig_path(path):
             return _check_rig(path, chosen, fixes)
-        return [fixes.file(path, chosen) if fixes is not None else checking.check_file(path, chosen)]
+        return [fixes.file(path, chosen) if fixes is not None
+                else checking.check_file(path, chosen)], 0
     except SettingsError as e:  # it names a settings file, whose path may hold any character
         raise SettingsError(printable(e.message), hint=e.hint) from None
 
 
-def _check_rig(path: str, chosen, fixes) -> list:
-    """A rig file's findings and its programs' (mercmac.rig.checks); --fix takes .mcm files."""
+def _check_rig(path: str, chosen, fixes) -> tuple[list, int]:
+    """A rig file's findings and its programs' (mercmac.rig.open); --fix takes .mcm files.
+    A rig file that cannot be read is said as any file is (no findings, one unread)."""
     from mercmac.cli.common import UsageError
     from mercmac.names import printable
-    from mercmac.rig.checks import check_rig_path
+    from mercmac.rig.open import RigUnreadable, open_rig
 
     if fixes is not None:
         raise UsageError(f"--fix and --diff take .mcm files, and {printable(path)} is a rig file",
                          hint="give the rig's programs to fix them")
-    return check_rig_path(path, chosen)
-
-
-def _programs_unread(path: str, checked: list) -> int:
-    """How many programs of the rig at `path` could not be read (shown as MR002): they make
-    the exit code 2, as any unreadable file does (mercmac.rig.checks.unreadable_programs)."""
-    from mercmac.rig import is_rig_path
-
-    if not is_rig_path(path):
-        return 0
-    from mercmac.rig.checks import unreadable_programs
-
-    return unreadable_programs(checked)
+    try:
+        opened = open_rig(path, chosen)
+    except RigUnreadable as e:
+        say(e.message)
+        return [], 1
+    return opened.findings, opened.unread
 
 
 def _show(found, results, fmt: str, statistics: bool, limit: int | None) -> None:

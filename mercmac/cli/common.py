@@ -180,3 +180,20 @@ def _escaped(text: str) -> str:
     from mercmac.names import printable
 
     return "\n".join(printable(line) for line in text.split("\n"))
+
+
+def opened(accept: Callable[[], object], stream=None):
+    """`accept()` (rig.open: a rig file, or a lone program as a rig of one), or None after
+    showing `check`'s findings on stderr (or `stream`): the rig or the program has errors,
+    and the command exits 1, as `sim FILE` with errors does. A program that cannot be read
+    is shown alike, then raised (exit 2, as for any file)."""
+    from mercmac.render.report import write_findings
+    from mercmac.rig.open import ProgramsUnread, RigRefused
+
+    try:
+        return accept()
+    except RigRefused as e:
+        write_findings(e.findings, stream)
+        if isinstance(e, ProgramsUnread):
+            raise
+        return None

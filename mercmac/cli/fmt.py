@@ -56,13 +56,12 @@ def _programs(files: tuple[str, ...]) -> tuple[list[str], int]:
 
 def _rig_programs(path: str) -> list[str] | None:
     """The program files of the rig at PATH, or None when the rig cannot be read (said)."""
-    from mercmac.errors import InputError
     from mercmac.render import report as render
-    from mercmac.rig.accept import read
+    from mercmac.rig.open import RigUnreadable, open_rig
 
     try:
-        rig_file = read(path)  # the rig commands' one reader; fmt runs nothing, so no check
-    except InputError as e:
+        rig_file = open_rig(path).rig_file  # fmt runs nothing: its programs are not checked
+    except RigUnreadable as e:
         say(e.message)
         return None
     if rig_file.rig is None:

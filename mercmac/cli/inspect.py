@@ -223,15 +223,9 @@ def describe(file, port, address, baud, timeout, fmt, graph) -> None:
     def work() -> int:
         graph_kind = _graph_kind(graph) if graph is not None else None  # before the port is read
         library = _library()
-        if file and not port and _is_rig(file):
-            rig, programs = _rig_programs(file)
-            text = library.describe_rig(rig, programs, fmt)
-            dot = library.rig_graph_dot(rig, programs) if graph is not None else None
-        else:
-            read = _named(_read(file, port, address, baud, timeout))
-            text = library.describe(read.macros, model=read.model, fmt=fmt, names=read.names)
-            dot = None if graph is None else library.call_graph_dot(
-                read.macros, model=read.model, names=read.names)
+        rig, programs = _described(file, port, address, baud, timeout)
+        text = library.describe_rig(rig, programs, fmt)
+        dot = library.rig_graph_dot(rig, programs) if graph is not None else None
         if graph is not None:
             _write_graph(dot, graph, graph_kind)
         click.echo(text, nl=not text.endswith("\n"))
@@ -244,27 +238,29 @@ def describe(file, port, address, baud, timeout, fmt, graph) -> None:
     _guarded(work)
 
 
-def _is_rig(path: str) -> bool:
-    from mercmac.rig import is_rig_path
-
-    return is_rig_path(path)
-
-
-def _rig_programs(path: str):
-    """The rig at PATH and each controller's program as it would be stored
-    (decompile.Stored, by controller name); _Refused when `check` finds errors in the rig
-    (shown as `check` shows them), as `sim RIG` refuses it."""
-    from mercmac.cli.run_rig import checked_rig
+def _described(file: str | None, port: str | None, address: int, baud: int, timeout: float):
+    """The rig to describe and each controller's program as it would be stored
+    (decompile.Stored, by controller name): a rig file's, or a lone program's or the
+    controller's on --port as a rig of one. _Refused when `check` finds errors (shown as
+    `check` shows them), as `sim` refuses them."""
+    from mercmac.cli.common import opened
     from mercmac.decompile import Stored
+    from mercmac.rig.model import Rig
+    from mercmac.rig.open import open_any
 
-    accepted = checked_rig(path)  # InputError (exit 2) when it cannot be read
+    if port is not None or file is None:
+        read = _named(_read(file, port, address, baud, timeout))
+        rig = Rig.of_program(read.origin, read.model)
+        return rig, {rig.controllers[0].name: Stored(read.macros, read.model, read.names)}
+    accepted = opened(lambda: open_any(file))  # InputError (exit 2) when it cannot be read
     if accepted is None:
         raise _Refused()
     rig = accepted.rig
-    programs = {name: c.program for name, c in accepted.programs.items()}
-    return rig, {c.name: Stored({m.slot: m.line for m in programs[c.name].macros.values()},
-                                c.model, programs[c.name].names())
-                 for c in rig.controllers}
+    # a rig's controller has its model; a lone program the one its `target` line names
+    models = {c.name: c.model if not rig.lone else None for c in rig.controllers}
+    return rig, {name: Stored({m.slot: m.line for m in c.program.macros.values()},
+                              models[name] or c.program.target, c.program.names())
+                 for name, c in accepted.programs.items()}
 
 
 def _graph_kind(path: str) -> str:

@@ -6,6 +6,11 @@ chooses them up front and skips it, Enter cuts it short. After power-on keys
 1-4 press and release the buttons (5 and 6: joystick and its button), r resets
 (power-on again, like RT: the held buttons stay held), q quits and prints the
 summary of the run. Simulated time follows the wall clock times the speed factor.
+
+The keys are the box's, plugged into one controller of the simulation (a lone program's,
+or the one a rig names with `box`): they press only what a person can press there (a wired
+input keeps its wire's level, rig.presses), and the screen shows that controller; power-on
+and the clock are the whole rig's.
 """
 from __future__ import annotations
 
@@ -19,9 +24,7 @@ from mercmac.cli.common import UsageError
 from mercmac.render import sim as render
 from mercmac.render.console import write_lines
 from mercmac.vm import events as ev
-from mercmac.vm.machine import Machine
-from mercmac.sim.record import Recorder
-from mercmac.sim.simulate import Run
+from mercmac.sim.simulate import Run, Simulation
 
 TICK_S = 0.05  # redraw period
 SLICE_MS = 100  # simulated time run between two looks at the wall clock
@@ -34,9 +37,10 @@ SHOWN = (ev.InputChanged, ev.OutputsChanged, ev.Reported, ev.HazardFound, ev.Mov
          ev.MoveEnded, ev.HomeDefined, ev.ProgramEnded)
 
 
-def run(machine: Machine, *, speed: float = 1.0, hold: tuple[int, ...] = (),
+def run(sim: Simulation, box: str, *, speed: float = 1.0, hold: tuple[int, ...] = (),
         stdin: IO | None = None, stdout: IO[str] | None = None) -> int:
-    """Run the box until q, then print the summary; the number of hazards found.
+    """Run the box on controller `box` until q, then print its summary; the number of
+    hazards found.
 
     The terminal is put back as it was, whatever happens.
     """
@@ -52,14 +56,29 @@ def run(machine: Machine, *, speed: float = 1.0, hold: tuple[int, ...] = (),
     fd = stdin.fileno()
     saved = termios.tcgetattr(fd)
     tty.setcbreak(fd)  # keys arrive one by one, without Enter and without echo
-    record = Recorder()
-    record.know(machine.chunks)  # the summary counts what the timeline would
+    box_ = _Box(sim, box)
     try:
-        _loop(machine, record, speed, hold, fd, stdout)
+        _loop(box_, speed, hold, fd, stdout)
     finally:
         _restore(fd, saved, stdout)
+    machine, record = box_.machine, sim.records[box]
     write_lines(render.summary(Run(machine, record, round(machine.now_ms))), stdout)
     return len(record.hazards)
+
+
+class _Box:
+    """The C-170.PB box on one controller of the simulation: its keys press what a person can
+    press there (a key of an input the box cannot press does nothing: a wire keeps its line)."""
+
+    def __init__(self, sim: Simulation, name: str):
+        from mercmac.rig.presses import refusal
+
+        self.sim, self.machine = sim, sim.machines[name]
+        self.pressable = {n for n in range(1, 7) if refusal(sim.rig, name, n) is None}
+
+    def toggle(self, n: int) -> None:
+        if n in self.pressable:
+            self.machine.set_input(n, not self.machine.input(n))
 
 
 def _restore(fd: int, saved: list, stdout: IO[str]) -> None:
@@ -75,21 +94,21 @@ def _restore(fd: int, saved: list, stdout: IO[str]) -> None:
         pass
 
 
-def _loop(machine: Machine, record: Recorder, speed: float, hold: tuple[int, ...], fd: int,
-          out: IO[str]) -> None:
+def _loop(box: _Box, speed: float, hold: tuple[int, ...], fd: int, out: IO[str]) -> None:
     pending: list = []
-    machine.listeners += [record.on_event, pending.append]
+    machine = box.machine
+    machine.listeners.append(pending.append)
     out.write(f"{HELP}  (speed x{speed:g})\n")
     for n in hold:
         machine.set_input(n, True)
-    if not hold and not _count_down(machine, fd, out):
+    if not hold and not _count_down(box, fd, out):
         _show(pending, machine, out)
         return
-    machine.power_on()
+    box.sim.power_on()
     start = time.monotonic()
     while True:
         ready, _, _ = select.select([fd], [], [], TICK_S)
-        _advance(machine, (time.monotonic() - start) * 1000 * speed, time.monotonic() + TICK_S)
+        _advance(box.sim, (time.monotonic() - start) * 1000 * speed, time.monotonic() + TICK_S)
         for key in os.read(fd, 64).decode(errors="ignore") if ready else "":
             if key in "qQ":
                 _show(pending, machine, out)
@@ -98,18 +117,17 @@ def _loop(machine: Machine, record: Recorder, speed: float, hold: tuple[int, ...
                 _show(pending, machine, out)
                 out.write(CLEAR)
                 write_lines([render.reset_line(machine.now_us)], out)
-                machine.power_on()
+                box.sim.power_on()
             elif key in "123456":
-                n = int(key)
-                machine.set_input(n, not machine.input(n))
+                box.toggle(int(key))
         _show(pending, machine, out)
 
 
-def _count_down(machine: Machine, fd: int, out: IO[str]) -> bool:
+def _count_down(box: _Box, fd: int, out: IO[str]) -> bool:
     """Keys 1-6 toggle the inputs held at power-on until the count-down ends; False on q."""
     end = time.monotonic() + COUNTDOWN_S
     while (left := end - time.monotonic()) > 0:
-        out.write(CLEAR + render.countdown_status(left, machine.input_lines()))
+        out.write(CLEAR + render.countdown_status(left, box.machine.input_lines()))
         out.flush()
         ready, _, _ = select.select([fd], [], [], min(TICK_S, left))
         for key in os.read(fd, 64).decode(errors="ignore") if ready else "":
@@ -118,20 +136,20 @@ def _count_down(machine: Machine, fd: int, out: IO[str]) -> bool:
             if key in "\r\n ":
                 return True
             if key in "123456":
-                machine.set_input(int(key), not machine.input(int(key)))
+                box.toggle(int(key))
     return True
 
 
-def _advance(machine: Machine, t_ms: float, deadline: float) -> None:
+def _advance(sim: Simulation, t_ms: float, deadline: float) -> None:
     """Run towards t_ms, but stop at the wall-clock deadline so that keys are read on time."""
     while time.monotonic() < deadline:
-        until = min(t_ms, machine.now_ms + SLICE_MS)
-        machine.run_until(until)
+        until = min(t_ms, sim.now_ms() + SLICE_MS)
+        sim.run_until(until)
         if until == t_ms:
             return
 
 
-def _show(pending: list, machine: Machine, out: IO[str]) -> None:
+def _show(pending: list, machine, out: IO[str]) -> None:
     """Print what happened since the last tick above the status line, then redraw it."""
     lines = [render.event_line(e) for e in pending if isinstance(e, SHOWN)]
     pending.clear()

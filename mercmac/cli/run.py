@@ -1,19 +1,31 @@
-"""The work of `mercmac sim`: options to a request, compile, simulate one way or another
-(scripted, a scenario, the live box of cli/interactive.py), render; the library's errors
-worded as the options' (exit 2)."""
+"""The work of `mercmac sim`: options to a request, open the program or the rig (a lone
+program is a rig of one), simulate one way or another (scripted, a scenario, the live box of
+cli/interactive.py), render; the library's errors worded as the options' (exit 2).
+
+On a rig (docs/rigs.md), `--buttons NAME:B@T1-T2` presses button B of the box, which must be
+plugged into controller NAME (without NAME: the rig's box controller), or the joystick's
+input 5 or 6 of a controller a branch goes to, never an input a wire drives (rig.presses);
+`--joystick NAME=D@T1-T2` holds the joystick branch of controller NAME (or of branch X, Y,
+Z) at deflection D (-1..1) from T1 to T2, then back to the middle.
+"""
 from __future__ import annotations
 
 import os
+import re
 import sys
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 from mercmac.commands import MAX_INT32
-from mercmac.cli.common import UsageError, say
+from mercmac.cli.common import UsageError, opened, say
 from mercmac.errors import interrupt
 from mercmac.outfile import drafting, writable_target
-from mercmac.timespec import TimeSpecError, parse_buttons, parse_duration
+from mercmac.rig.model import Rig
+from mercmac.timespec import TimeSpecError, merge, parse_buttons, parse_duration
 from mercmac.vm.models import Options
-from mercmac.sim.simulate import DEFAULT_UNTIL_MS, Run, machine_for, schedule, simulate
+
+_HOLD = re.compile(r"\s*(\w+)\s*=\s*([+-]?(?:\d+\.?\d*|\.\d+))\s*@\s*([^-]+?)\s*(?:-\s*(.+?))?\s*")
+_NAMED = re.compile(r"\s*(\w+)\s*:(.*)", re.DOTALL)
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,7 +51,22 @@ class Request:
     verbose: int = 0  # timeline: 0 the story, 1 with macro entries and exits, 2 everything
     fail_on_hazard: bool = False
     hold: str = ""  # --interactive: inputs held at power-on, e.g. "2" or "2+3"
-    joystick: str = ""  # a rig: NAME=D@T1-T2,... (cli/run_rig.py)
+    joystick: str = ""  # a rig: NAME=D@T1-T2,...
+
+
+@dataclass(frozen=True, slots=True)
+class Script:
+    """What a person does in a scripted run: presses by controller (a lone program's, which
+    has no names, in `lone`), joystick holds, inputs held at power-on (--interactive)."""
+
+    presses: dict
+    holds: list
+    held: tuple[int, ...]
+    lone: list
+
+    def by_name(self, rig: Rig) -> dict:
+        """The presses by controller of `rig` (a lone program's are its one controller's)."""
+        return {rig.controllers[0].name: self.lone} if rig.lone else self.presses
 
 
 def run(req: Request) -> bool:
@@ -58,20 +85,19 @@ def run(req: Request) -> bool:
 
 def _run(req: Request) -> bool:
     from mercmac.rig import is_rig_path
+    from mercmac.rig.open import open_rig
 
-    if is_rig_path(req.file):  # every controller of the rig on one clock
-        from mercmac.cli import run_rig
-
-        return run_rig.run(req)
-    if req.joystick:
+    rig_file = None
+    if is_rig_path(req.file):  # its controllers' names are needed to read the script
+        _refuse_single_only(req)
+        rig_file = open_rig(req.file)
+        if rig_file.rig is None:  # the rig file itself has errors: shown as `check` does
+            opened(rig_file.accepted)
+            return False
+    elif req.joystick:
         raise UsageError("--joystick is for a rig file (*.rig.toml), whose [joystick] table "
                          "says which controller each branch drives")
-    presses = _presses(req.buttons)
-    if req.scenario and presses:  # two button scripts for one run: which one wins is a guess
-        raise UsageError("--scenario and --buttons cannot be used together: the scenario's "
-                         "[[step]] tables are its button script; add the presses there "
-                         "(at = \"1s\", press = [1], then release = [1])")
-    hold = _hold(req)
+    script = _script(req, rig_file.rig if rig_file else None)
     if req.vcd:  # a path that cannot be written is refused before any work (exit 2)
         writable_target(req.vcd)
     if req.plot:  # and so is a plot that cannot be drawn: a bad path, no matplotlib
@@ -80,26 +106,54 @@ def _run(req: Request) -> bool:
         _check_plot(req.plot)
     options = Options(servo_on=not req.servo_off, reference_at=req.reference_at,
                       hard_limits=_limits(req.hard_limits))
-    program = _compile(req)
-    if program is None:
+    accepted = opened(rig_file.accepted if rig_file else _lone(req))
+    if accepted is None:
         return False
-    common = dict(model=req.target or program.target, cycle_ms=req.cycle_ms, options=options)
+    rig = accepted.rig
+    programs = {name: c.program for name, c in accepted.programs.items()}
     if req.interactive:
-        from mercmac.cli import interactive
-        from mercmac.vm.machine import Machine
-
-        machine = Machine(program, **common)
-        schedule(machine, presses)
-        hazards = interactive.run(machine, speed=req.speed, hold=hold)
-        return _hazards_ok(req, hazards)
+        return _interactive(req, rig, programs, script, options)
     if req.scenario:
-        return _scenario(req, program, presses, common)
+        return _scenario(req, rig, programs, script, options)
     until = _until(req.until, None)
-    result = _simulate(req, program, presses, until, common)
+    result = _simulate(req, rig, programs, script, options, until)
     _render(req, result)
     if result.interrupted:  # Ctrl-C: the timeline so far and the summary, then exit 128+N
         raise interrupt(result.interrupted)
-    return _hazards_ok(req, len(result.record.hazards))
+    return _hazards_ok(req, result.hazards)
+
+
+def _lone(req: Request):
+    """The file as a rig of one, opened when asked (rig.open.open_program)."""
+    from mercmac.rig.open import open_program
+
+    return lambda: open_program(req.file, target=req.target)
+
+
+def _refuse_single_only(req: Request) -> None:
+    """Options of one controller's run that a rig does not take (yet): said, not ignored."""
+    for given, option in ((req.target, "--target"), (req.hard_limits, "--hard-limits")):
+        if given:
+            raise UsageError(f"{option} is not available for a rig file; each controller's "
+                             "model comes from the rig file")
+
+
+def _script(req: Request, rig: Rig | None) -> Script:
+    """The presses, the joystick and the inputs held at power-on, as the options give them;
+    on a rig (`rig`), by controller and only what a person can press there."""
+    presses = _presses(req.buttons) if rig is None else buttons(rig, req.buttons)
+    holds = [] if rig is None else joystick(rig, req.joystick)
+    if req.scenario and presses:  # two button scripts for one run: which one wins is a guess
+        where = ("; add the presses there (at = \"1s\", press = [1], then release = [1])"
+                 if rig is None else " (controller = \"x\" says whose)")
+        raise UsageError("--scenario and --buttons cannot be used together: the scenario's "
+                         f"[[step]] tables are its button script{where}")
+    held = _hold(req)
+    if rig is not None and held:
+        _refuse_unpressable(rig, _box_of(rig), held, f"--hold '{req.hold}'")
+    if rig is None:
+        return Script({}, holds, held, presses)
+    return Script(presses, holds, held, [])
 
 
 def _hazards_ok(req: Request, hazards: int) -> bool:
@@ -125,12 +179,109 @@ def _hold(req: Request) -> tuple[int, ...]:
     return press.inputs
 
 
-def _simulate(req: Request, program, presses, until: int, common: dict) -> Run:
-    watch = _watch(req)
-    result = _simulate_with(req, program, presses, until,
-                            dict(common, watch=watch, progress=_progress(until)))
-    _plot(req, watch, until * 1000)
+# -- the simulation, its views and its files -------------------------------------------------
+
+def _simulation(req: Request, rig: Rig, programs: dict, script: Script, options: Options,
+                listeners: dict, fast_forward: str = "all"):
+    from mercmac.sim.simulate import Simulation
+
+    sim = Simulation(rig, programs, cycle_ms=req.cycle_ms, options=options, trace=req.trace,
+                     listeners=listeners, fast_forward=fast_forward)
+    for name, pressed in script.by_name(rig).items():
+        sim.press(name, pressed)
+    for hold in script.holds:
+        sim.hold(hold)
+    return sim
+
+
+def _simulate(req: Request, rig: Rig, programs: dict, script: Script, options: Options,
+              until: int):
+    """The plain run to --until, with the plot's and the VCD's listeners when asked for,
+    and a progress line on a terminal; the plot and the dump are written once it is over."""
+    with _views(req, rig) as views:
+        sim = _simulation(req, rig, programs, script, options, views.listeners())
+        result = sim.run(until, _progress(until))
+        views.close(result)
     return result
+
+
+def _scenario(req: Request, rig: Rig, programs: dict, script: Script,
+              options: Options) -> bool:
+    from mercmac.sim import scenario
+
+    plan = scenario.load(req.scenario)
+    until = _until(req.until, plan.until_ms)
+    with _views(req, rig) as views:
+        sim = _simulation(req, rig, programs, script, options, views.listeners())
+        try:
+            checked = scenario.run(sim, plan, until)
+        except scenario.ScenarioFailed:
+            failed = sim.result(round(sim.now_ms()))
+            views.close(failed)
+            _render(req, failed)
+            raise
+        result = sim.result(until)
+        views.close(result)
+    _render(req, result)
+    if req.fmt == "text":
+        from mercmac.render import sim as render
+
+        render.write_scenario_passed(req.scenario, checked, sys.stdout)
+    return _hazards_ok(req, result.hazards)
+
+
+class _Views:
+    """The plot's and the VCD's listeners of a run, as the options ask for them."""
+
+    def __init__(self, req: Request, rig: Rig):
+        self.req, self.rig = req, rig
+        self.watched = {}
+        self.dump = self.draft = None
+        if req.plot:
+            from mercmac.sim import plot
+
+            self.watched = plot.watches(rig)
+
+    def listeners(self) -> dict[str, list]:
+        """Every controller's listeners: the plot's first, then the dump's."""
+        joined: dict[str, list] = {name: [w.on_event] for name, w in self.watched.items()}
+        for name, listeners in (self.dump.listeners() if self.dump else {}).items():
+            joined.setdefault(name, []).extend(listeners)
+        return joined
+
+    def close(self, result) -> None:
+        """The run is over, or stopped at `result.until_ms`: the dump and the plot end there."""
+        end = round(result.until_ms * 1000)
+        if self.dump is not None:
+            self.dump.close(end)
+            result.vcd_cut_at = self.dump.cut_at
+            self.draft.keep = not result.interrupted  # a dump cut short keeps the old file
+        if self.watched:
+            from mercmac.sim import plot
+
+            plot.write_run(self.req.plot, self.rig, self.watched, end,
+                           f"mercmac sim {os.path.basename(self.req.file)}")
+
+
+@contextmanager
+def _views(req: Request, rig: Rig):
+    """The views of a run; the VCD replaces the old file only when the run went through (an
+    error or Ctrl-C leaves the old one and no temp), and says where its size limit cut it."""
+    views = _Views(req, rig)
+    if not req.vcd:
+        yield views
+        return
+    from mercmac.sim.vcd import Dump
+
+    limit = round(req.vcd_limit_mb * 1_000_000) if req.vcd_limit_mb else None
+    with drafting(req.vcd, encoding="ascii") as draft:
+        views.draft = draft
+        views.dump = Dump(draft.file, [c.name for c in rig.controllers], limit)
+        yield views
+    if views.dump.cut_at is not None and draft.keep:
+        from mercmac.render import sim as render
+
+        render.write_vcd_cut(req.vcd, req.vcd_limit_mb, views.dump.cut_at, sys.stderr)
 
 
 def _progress(until_ms: int):
@@ -142,44 +293,25 @@ def _progress(until_ms: int):
     return ProgressLine(sys.stderr, until_ms)
 
 
-def _simulate_with(req: Request, program, presses, until: int, common: dict) -> Run:
-    if not req.vcd:
-        return simulate(program, presses=presses, until_ms=until, trace=req.trace, **common)
-    # the old file stays until the new one is complete; Ctrl-C or an error leaves no temp
-    limit = round(req.vcd_limit_mb * 1_000_000) if req.vcd_limit_mb else None
-    with drafting(req.vcd, encoding="ascii") as vcd:
-        result = simulate(program, presses=presses, until_ms=until, trace=req.trace,
-                          vcd=vcd.file, vcd_limit=limit, **common)
-        vcd.keep = not result.interrupted  # a dump cut by Ctrl-C does not replace the old file
-    if result.vcd_cut_at is not None and not result.interrupted:
-        from mercmac.render import sim as render
+def _interactive(req: Request, rig: Rig, programs: dict, script: Script,
+                 options: Options) -> bool:
+    """The live box (cli/interactive.py) on the box's controller, every controller on the
+    clock; --hold holds its inputs at power-on. Passes that emit something are stepped, so
+    that the screen shows every LED change (fast_forward "quiet")."""
+    from mercmac.cli import interactive
 
-        render.write_vcd_cut(req.vcd, req.vcd_limit_mb, result.vcd_cut_at, sys.stderr)
-    return result
+    box = _box_of(rig)
+    sim = _simulation(req, rig, programs, script, options, {}, fast_forward="quiet")
+    hazards = interactive.run(sim, box, speed=req.speed, hold=script.held)
+    return _hazards_ok(req, hazards)
 
 
-def _scenario(req: Request, program, presses, common: dict) -> bool:
-    from mercmac.sim import scenario
-
-    plan = scenario.load(req.scenario)
-    until = _until(req.until, plan.until_ms)
-    watch = _watch(req)
-    machine, record = machine_for(program, trace=req.trace, **common,
-                                  listeners=[watch.on_event] if watch else [])
-    schedule(machine, presses)
-    try:
-        checked = scenario.run(machine, plan, until)
-    except scenario.ScenarioFailed:
-        _plot(req, watch, round(machine.now_ms * 1000))
-        _render(req, Run(machine, record, round(machine.now_ms)))
-        raise
-    _plot(req, watch, until * 1000)
-    _render(req, Run(machine, record, until))
-    if req.fmt == "text":
-        from mercmac.render import sim as render
-
-        render.write_scenario_passed(req.scenario, checked, sys.stdout)
-    return _hazards_ok(req, len(record.hazards))
+def _box_of(rig: Rig) -> str:
+    """The controller the box is plugged into, which --interactive and --hold press."""
+    if rig.box is None:
+        raise UsageError("--interactive needs the rig's box: say which controller holds the "
+                         "C-170.PB with box = \"NAME\" in the rig file")
+    return rig.box
 
 
 def _check_plot(path: str) -> None:
@@ -192,24 +324,7 @@ def _check_plot(path: str) -> None:
         raise UsageError(f"--plot {e.message}", hint=e.hint) from None
 
 
-def _watch(req: Request):
-    """The plot's listener when --plot asks for one."""
-    if not req.plot:
-        return None
-    from mercmac.sim import plot
-
-    return plot.PlotObserver()
-
-
-def _plot(req: Request, watch, end_us: int) -> None:
-    if watch is not None:
-        from mercmac.sim import plot
-
-        title = f"mercmac sim {os.path.basename(req.file)}"
-        plot.write(req.plot, watch.close(end_us), title)
-
-
-def _render(req: Request, result: Run) -> None:
+def _render(req: Request, result) -> None:
     from mercmac.render import sim as render
 
     if req.fmt == "json":
@@ -218,16 +333,7 @@ def _render(req: Request, result: Run) -> None:
         render.write_text(result, sys.stdout, with_trace=req.trace, verbose=req.verbose)
 
 
-def _compile(req: Request):
-    """The program, or None after showing the errors (a file with errors is not simulated)."""
-    from mercmac.compiler import compile_file
-    from mercmac.render import report
-
-    compiled = compile_file(req.file, target=req.target)
-    if report.write_errors(compiled):
-        return None
-    return compiled.program
-
+# -- the options' texts ----------------------------------------------------------------------
 
 def _presses(spec: str):
     try:
@@ -236,7 +342,87 @@ def _presses(spec: str):
         raise UsageError(f"--buttons: {e}") from None
 
 
+def buttons(rig: Rig, spec: str) -> dict:
+    """`--buttons` on a rig: 'x:1@0-300ms,y:5@1s' by controller; a press without a name
+    goes to the box's controller. Only what a person can press (rig.presses): the box's
+    connected buttons on its controller, on inputs no wire drives, and the joystick's inputs
+    on a controller a branch goes to."""
+    found: dict[str, list] = {}
+    for item in filter(None, (p.strip() for p in spec.split(","))):
+        named = _NAMED.fullmatch(item)
+        name, press = (named.group(1), named.group(2)) if named else (_box(rig, item), item)
+        _known(rig, name, "--buttons", item)
+        try:
+            pressed = parse_buttons(press)
+        except TimeSpecError as e:
+            raise UsageError(f"--buttons: {e}") from None
+        inputs = {n for p in pressed for n in p.inputs}
+        _refuse_unpressable(rig, name, inputs, f"--buttons '{item}'")
+        found.setdefault(name, []).extend(pressed)
+    return {name: merge(presses) for name, presses in found.items()}
+
+
+def _refuse_unpressable(rig: Rig, name: str, inputs, said: str) -> None:
+    """UsageError, naming the box's controller or the wire, for an input no one can press."""
+    from mercmac.rig.presses import refusal
+
+    for number in sorted(inputs):
+        why = refusal(rig, name, number)
+        if why:
+            raise UsageError(f"{said}: {why}")
+
+
+def _box(rig: Rig, item: str) -> str:
+    """The controller a press without a name goes to: the box's."""
+    from mercmac.rig.presses import refusal
+
+    if rig.box is None:
+        raise UsageError(f"--buttons '{item}': {refusal(rig, '', 1)}",
+                         hint="the joystick's inputs 5 and 6 take their controller's name: "
+                              "NAME:5@T1-T2")
+    return rig.box
+
+
+def _known(rig: Rig, name: str, option: str, item: str) -> None:
+    if not any(c.name == name for c in rig.controllers):
+        names = ", ".join(c.name for c in rig.controllers)
+        raise UsageError(f"{option} '{item}': the rig has no controller '{name}' ({names})")
+
+
+def joystick(rig: Rig, spec: str) -> list:
+    """`--joystick x=+0.5@1s-3s,Y=-1@4s`: a controller (or a branch X/Y/Z of the rig's
+    [joystick]) held at a deflection -1..1 from T1 to T2 (or on from T1)."""
+    return [_deflection(rig, item) for item in filter(None, (p.strip() for p in spec.split(",")))]
+
+
+def _deflection(rig: Rig, item: str):
+    from mercmac.sim.simulate import Hold
+
+    m = _HOLD.fullmatch(item)
+    if m is None:
+        raise UsageError(f"--joystick '{item}': write NAME=D@T1-T2 or NAME=D@T1, "
+                         "e.g. x=+0.5@1s-3s (D from -1 to 1)")
+    who, value, start, end = m.groups()
+    name = rig.joystick.get(who, who)  # a branch names its controller
+    _known(rig, name, "--joystick", item)
+    if name not in rig.joystick.values():
+        raise UsageError(f"--joystick '{item}': no joystick branch goes to {name}; the rig's "
+                         "[joystick] table says which branch (X, Y, Z) goes where")
+    deflection = float(value)
+    if not -1 <= deflection <= 1:
+        raise UsageError(f"--joystick '{item}': the deflection is from -1 to 1")
+    try:
+        t0, t1 = parse_duration(start), parse_duration(end) if end else None
+    except TimeSpecError as e:
+        raise UsageError(f"--joystick '{item}': {e}") from None
+    if t1 is not None and t1 < t0:
+        raise UsageError(f"--joystick '{item}': the end is before the start")
+    return Hold(name, deflection, t0, t1)
+
+
 def _until(text: str | None, fallback: int | None) -> int:
+    from mercmac.sim.simulate import DEFAULT_UNTIL_MS
+
     if text is None:
         return DEFAULT_UNTIL_MS if fallback is None else fallback
     try:

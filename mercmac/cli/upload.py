@@ -640,7 +640,7 @@ def _emulated_rig(path: str):
     """The rig at PATH when `check` finds no errors in it (docs/rigs.md); else what `check`
     finds is shown as `check` shows it, and nothing is served (exit 1, as `sim RIG`)."""
     from mercmac.render.report import write_findings
-    from mercmac.rig.accept import ProgramsUnread, RigRefused, accept
+    from mercmac.rig.open import ProgramsUnread, RigRefused, accept
 
     try:
         return accept(path).rig

@@ -2,7 +2,9 @@
 as `describe` describes one (mercmac.decompile.prose) under its controller's name and
 address, what each wire carries (the macros that set its output and those that wait on or
 read its input, MS176E §4.5.1 "interaxis communication"), and one call graph with a
-cluster per controller and the wires as edges between the clusters."""
+cluster per controller and the wires as edges between the clusters. A rig of one (a lone
+program) is its program described, as the controllers are named only where there are
+several."""
 from __future__ import annotations
 
 import json
@@ -11,7 +13,8 @@ from typing import Mapping, NamedTuple
 
 from mercmac.commands import Mnemonic
 from mercmac.mdtext import slot_name
-from mercmac.decompile.prose import Reader, describe, described, dot_body, mermaid_body
+from mercmac.decompile.prose import (Reader, call_graph_dot, describe, described, dot_body,
+                                      mermaid_body)
 from mercmac.names import dot, markdown, mermaid, printable
 from mercmac.render.sim import plural
 
@@ -44,6 +47,8 @@ class Touch(NamedTuple):
 
 def describe_rig(rig, programs: Mapping[str, Stored], fmt: str = "text") -> str:
     """The rig in words; `programs`: each controller's Stored program by controller name."""
+    if not rig.several:
+        return _described_as(programs[rig.controllers[0].name], fmt)
     programs = _wired(rig, programs)
     readers = {c.name: Reader(*programs[c.name]) for c in rig.controllers}
     if fmt == "json":
@@ -181,7 +186,11 @@ def _touch(t: Touch) -> dict:
 def rig_graph_dot(rig, programs: Mapping[str, Stored]) -> str:
     """Graphviz dot: a cluster per controller with its call graph (prose.dot_body), a node
     per wired line in its controller's cluster, the wire as a bold edge between clusters,
-    and dotted edges from the macros that set an output and to those that read an input."""
+    and dotted edges from the macros that set an output and to those that read an input;
+    a rig of one: its program's call graph (prose.call_graph_dot)."""
+    if not rig.several:
+        stored = programs[rig.controllers[0].name]
+        return call_graph_dot(stored.macros, model=stored.model, names=stored.names)
     programs = _wired(rig, programs)
     readers = {c.name: Reader(*programs[c.name]) for c in rig.controllers}
     out = ["digraph rig {", "    rankdir=LR;", "    compound=true;", "    node [shape=box];",

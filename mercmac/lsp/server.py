@@ -8,7 +8,7 @@ editor's workspace settings (mercmac.lsp.settings); only the compiling is increm
 (mercmac.lsp.symbols, mercmac.lsp.completion). Documents keep the editor's lines and
 convert every position, read or sent (mercmac.lsp.document); messages are read so that
 a bad frame does not stop the server (mercmac.lsp.framing). Rig files get what `check
-RIG` reports on them, and a rig's programs its models (mercmac.lsp.rigs).
+RIG` reports on them, and a rig's programs its models (mercmac.lsp.rig).
 """
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ from mercmac.commands import MODELS, Mnemonic
 from mercmac.compiler import Compilation, checking
 from mercmac.diagnostics import Diagnostic, Fix, Report, Severity
 from mercmac.errors import MercmacError, SettingsError
-from mercmac.lsp import completion as completion_rules, framing, rigs, settings, symbols
+from mercmac.lsp import completion as completion_rules, framing, rig, settings, symbols
 from mercmac.lsp.document import Document, Documents
 from mercmac.lsp.recheck import Checked, Rechecker
 from mercmac.mdtext import slot_name
@@ -133,9 +133,9 @@ class MercmacServer(LanguageServer):
         if not self.stale:
             asyncio.get_running_loop().call_soon(self.check_stale)
         self.stale.add(uri)
-        if rigs.is_rig_path(uri):  # its programs are checked with the models it names
+        if rig.is_rig_path(uri):  # its programs are checked with the models it names
             self.stale.update(u for u in self.workspace.text_documents
-                              if not rigs.is_rig_path(u))
+                              if not rig.is_rig_path(u))
 
     def check_stale(self) -> None:
         """Check what changed; what a failure left unchecked is checked next. While the
@@ -154,7 +154,7 @@ class MercmacServer(LanguageServer):
         """Check `uri` as `check` would, and publish what it reports."""
         self.stale.discard(uri)
         document: Document = self.workspace.get_text_document(uri)
-        if rigs.is_rig_path(uri):
+        if rig.is_rig_path(uri):
             return self.recheck_rig(uri, document)
         self.parsed.pop(uri, None)
         choice, owner = self.choice(uri), self.owner(uri)
@@ -179,7 +179,7 @@ class MercmacServer(LanguageServer):
         return seen
 
     def _compile(self, uri: str, source: Source, target: str | None,
-                 owner: rigs.Owner | None = None) -> Compilation:
+                 owner: rig.Owner | None = None) -> Compilation:
         """The re-checker's compilation; its AST is kept for the other features. A program
         of a rig also gets the rig's model-mismatch on a `target` line of another model."""
         checker = self.checkers.get(uri)
@@ -188,27 +188,27 @@ class MercmacServer(LanguageServer):
         checked = self.parsed[uri] = checker.check(source.text)
         if owner is None:
             return checked.compilation
-        return rigs.with_rig_model(checked.compilation, owner, checked.items)
+        return rig.with_rig_model(checked.compilation, owner, checked.items)
 
     def recheck_rig(self, uri: str, document: Document) -> Seen:
         """Check a rig file as `check RIG` would, and publish what it reports on the file."""
         source = Source(_path(uri), document.source)  # its programs are relative to it
-        found = rigs.rig_diagnostics(source, self.choice(uri))  # a failure: said at 1:1
+        found = rig.rig_diagnostics(source, self.choice(uri))  # a failure: said at 1:1
         seen = self.checks[uri] = Seen(Checked(Compilation(source, Report(source.name), None),
                                                None, ()), found, rig=True)
         self.text_document_publish_diagnostics(t.PublishDiagnosticsParams(
             uri=uri, version=document.version, diagnostics=_diagnostics(found, document)))
         return seen
 
-    def rig_rules(self, owner: rigs.Owner, source: Source, choice) -> list[Diagnostic]:
-        """The rig rules `check RIG` reports in a program of the rig (rigs)."""
+    def rig_rules(self, owner: rig.Owner, source: Source, choice) -> list[Diagnostic]:
+        """The rig rules `check RIG` reports in a program of the rig (lsp/rig.py)."""
         try:
-            return rigs.program_rig_diagnostics(owner, source, choice)
+            return rig.program_rig_diagnostics(owner, source, choice)
         except Exception as e:  # a bug in the rig checks must not stop the file's own check
             self.say(f"checking the rig of {source.name}: {type(e).__name__}: {e}"[:300])
             return []
 
-    def owner(self, uri: str) -> rigs.Owner | None:
+    def owner(self, uri: str) -> rig.Owner | None:
         """The rig that names the document at `uri` as a program (its open text counts)."""
         if not uri.startswith("file:"):
             return None
@@ -218,7 +218,7 @@ class MercmacServer(LanguageServer):
             return None if document is None else document.source
 
         try:
-            return rigs.owner_of(uris.to_fs_path(uri), open_text)
+            return rig.owner_of(uris.to_fs_path(uri), open_text)
         except Exception as e:  # a bug in reading rigs must not stop the file's own check
             self.say(f"finding the rig of {_name(uri)}: {type(e).__name__}: {e}"[:300])
             return None
@@ -376,7 +376,7 @@ def did_save(ls: MercmacServer, params: t.DidSaveTextDocumentParams) -> None:
         config.forget()
         ls.changed(params.text_document.uri)
         # a rig's checks read its programs as saved
-        ls.stale.update(u for u in ls.workspace.text_documents if rigs.is_rig_path(u))
+        ls.stale.update(u for u in ls.workspace.text_documents if rig.is_rig_path(u))
 
 
 @server.feature(t.TEXT_DOCUMENT_DID_CLOSE)
@@ -453,7 +453,7 @@ def _meanings(seen: Seen, line: int, column: int):
 def completion(ls: MercmacServer, params: t.CompletionParams) -> t.CompletionList:
     """The words that may stand at the cursor (mercmac.lsp.completion)."""
     uri = params.text_document.uri
-    if rigs.is_rig_path(uri):  # TOML: no macro words to offer
+    if rig.is_rig_path(uri):  # TOML: no macro words to offer
         return t.CompletionList(is_incomplete=False, items=[])
     document: Document = ls.workspace.get_text_document(uri)
     offset = document.offset_at(params.position)
@@ -594,7 +594,7 @@ def document_symbols(ls: MercmacServer, params: t.DocumentSymbolParams) -> list[
 @server.feature(t.TEXT_DOCUMENT_FORMATTING)
 def formatting(ls: MercmacServer, params: t.DocumentFormattingParams) -> list[t.TextEdit] | None:
     """The whole document as `mercmac fmt` writes it (one edit), or no edit."""
-    if rigs.is_rig_path(params.text_document.uri):  # `fmt RIG` leaves the TOML as written
+    if rig.is_rig_path(params.text_document.uri):  # `fmt RIG` leaves the TOML as written
         return None
     format_text = formatter()
     document: Document = ls.workspace.get_text_document(params.text_document.uri)

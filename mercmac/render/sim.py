@@ -1,8 +1,15 @@
 """Simulation output: the timeline, the trace, the summary (text) and the JSON
-(docs/simulator.md, "What sim writes")."""
+(docs/simulator.md, "What sim writes").
+
+One controller's run shows as a program's (a lone program is a rig of one). A rig of
+several shows one timeline of every controller, merged by time, each line carrying the
+controller's name, with the wires' edges between them, then each controller's summary; a
+wired input's change is the wire's edge, shown once as the wire, not as a button. Its JSON
+holds one `sim --format json` object per controller and the wires' edges (docs/rigs.md).
+"""
 from __future__ import annotations
 
-import json
+import heapq
 import math
 from itertools import islice
 from typing import IO, Iterator
@@ -17,7 +24,7 @@ from mercmac.vm import fastforward as ff
 from mercmac.vm.motion import Ended
 from mercmac.sim import record
 from mercmac.sim.record import Fold, Folded, Recorder
-from mercmac.sim.simulate import Run
+from mercmac.sim.simulate import Edge, Result, Run
 
 ON, OFF = "●", "○"
 TEXT_LIMIT = 2000  # lines of the story and of -v (-vv shows every line); JSON keeps 10,000
@@ -190,7 +197,7 @@ def _stretch(folds: list[Folded], level: int) -> list[tuple[int, Line]]:
 
 
 def at(t_us: float) -> Line:
-    """A timeline line's time column (render/rig.py dates its wires' edges alike)."""
+    """A timeline line's time column (a rig's wires' edges are dated alike)."""
     return [(f"{clock(t_us):>16}  ", "dim")]
 
 
@@ -209,26 +216,64 @@ def _story(events: list, level: int) -> Iterator[tuple[int, Line]]:
     yield from _stretch(folds, level)
 
 
-def dated_lines(events: list, level: int = 0) -> Iterator[tuple[int, Line]]:
-    """The timeline's shown lines of `events` (a recorder's timeline) with their times in
-    us, for a caller that merges several timelines into one (a rig, render/rig.py)."""
-    return _story(events, level)
-
-
-def timeline(rec: Recorder, level: int = 0) -> list[Line]:
-    """The timeline at a verbosity: 0 the story, 1 with macro entries and exits, 2 all.
+def timeline(result: Result, level: int = 0) -> list[Line]:
+    """The timeline at a verbosity: 0 the story, 1 with macro entries and exits, 2 all; in a
+    rig of several, every controller's and the wires' edges merged by time, at one instant in
+    the rig's order of controllers, each followed by the edges of the wires it drives (so an
+    output change reads before the wire, and the wire before what it starts).
 
     The story and `-v` stop after TEXT_LIMIT lines; `-vv` shows every line of the
     recorded timeline. Either way the last line counts exactly the lines left out.
     """
-    story = _story(rec.timeline, level)
-    dated = list(islice(story, TEXT_LIMIT if level < 2 else None))
-    cut = sum(1 for _ in story)  # what the text limit left out
-    hidden = cut + _unlisted(rec, level)
+    streams = []
+    for name, run in result.runs.items():
+        streams.append(_named(result, name, run.record.timeline, level))
+        if result.rig.several:
+            streams.append(_edges(result, name))
+    merged = heapq.merge(*streams, key=lambda pair: pair[0])
+    dated = list(islice(merged, TEXT_LIMIT if level < 2 else None))
+    cut = sum(1 for _ in merged)  # what the text limit left out
+    records = [run.record for run in result.runs.values()]
+    hidden = cut + sum(_unlisted(rec, level) for rec in records) + result.edges_dropped
     lines = [line for _, line in dated]
     if hidden:
-        lines.append(_left_out(hidden, dated[-1][0] if dated else 0, bool(cut), rec))
+        lines.append(_left_out(hidden, dated[-1][0] if dated else 0, bool(cut),
+                               any(rec.dropped["timeline"] for rec in records),
+                               result.edges_dropped))
     return lines
+
+
+def _named(result: Result, name: str, events: list, level: int) -> Iterator[tuple[int, Line]]:
+    """One controller's dated lines; in a rig of several, its name after the time and its
+    wired inputs left out (the wires' edges show them)."""
+    if not result.rig.several:
+        yield from _story(events, level)
+        return
+    wired = {w.target.number for w in result.rig.wires if w.target.controller == name}
+    shown = [e for e in events if not (type(e) is ev.InputChanged and e.input in wired)]
+    width = _width(result)
+    for t, line in _story(shown, level):
+        yield t, _with_name(line, name, width)
+
+
+def _width(result: Result) -> int:
+    return max(len(c.name) for c in result.rig.controllers)
+
+
+def _with_name(line: Line, name: str, width: int) -> Line:
+    return line[:1] + [(f"{name:<{width}}  ", "bold blue")] + line[1:]
+
+
+def _edges(result: Result, name: str) -> Iterator[tuple[int, Line]]:
+    """The edges of the wires `name` drives, dated."""
+    width = _width(result)
+    for edge in result.edges:
+        if edge.wire.source.controller == name:
+            yield edge.t, at(edge.t) + [(f"{'':<{width}}  wire {_edge_text(edge)}", "cyan")]
+
+
+def _edge_text(edge: Edge) -> str:
+    return f"{edge.wire.source} -> {edge.wire.target} {'ON' if edge.level else 'OFF'}"
 
 
 def _unlisted(rec: Recorder, level: int) -> int:
@@ -237,12 +282,16 @@ def _unlisted(rec: Recorder, level: int) -> int:
     return rec.unlisted_events + folds + (rec.unlisted_polled if level == 1 else 0)
 
 
-def _left_out(hidden: int, after_us: int, cut: bool, rec: Recorder) -> Line:
-    """The closing line of a cut timeline: how many lines, after when, and where the rest is."""
-    where = [f"-vv shows {'more' if rec.dropped['timeline'] else 'every line'}"] if cut else []
-    if rec.dropped["timeline"]:
+def _left_out(hidden: int, after_us: int, cut: bool, dropped: bool, edges: int) -> Line:
+    """The closing line of a cut timeline: how many lines, after when, and where the rest is
+    (`dropped`: a recorder stopped listing at its cap; `edges`: wire edges past theirs)."""
+    where = [f"-vv shows {'more' if dropped or edges else 'every line'}"] if cut else []
+    if dropped:
         where.append(f"the timeline keeps the first {record.TIMELINE_CAP:,} entries; "
                      "--vcd or --plot show the whole run")
+    if edges:
+        where.append(f"a run lists the first {record.CAP:,} wire edges; --vcd or --plot "
+                     "show them all")
     return [(f"{'':>16}  ... {plural(hidden, 'more line')} after {clock(after_us)} "
              f"({'; '.join(where)})", "dim")]
 
@@ -275,6 +324,40 @@ def summary(run: Run) -> list[Line]:
     ]
 
 
+def _endings(result: Result) -> list[Line]:
+    """Each running controller's last line at --until (named in a rig of several)."""
+    lines = [ending(run) for run in result.runs.values()]
+    if result.rig.several:
+        width = _width(result)
+        lines = [_with_name(line, name, width) if line else line
+                 for name, line in zip(result.runs, lines)]
+    return lines
+
+
+def _summaries(result: Result) -> list[Line]:
+    """Each controller's summary (named in a rig of several), and the wires' count."""
+    if not result.rig.several:
+        return summary(result.only)
+    lines: list[Line] = []
+    for name, run in result.runs.items():
+        block = summary(run)
+        block[1] = [(f"{name}", "bold blue"), (" ", "")] + block[1]
+        lines += block
+    edges = len(result.edges) + result.edges_dropped
+    return lines + [[], [(f"Wires: {plural(len(result.rig.wires), 'wire')}, "
+                          f"{plural(edges, 'edge')}", "")]]
+
+
+def _traces(result: Result) -> list[Line]:
+    """Each controller's trace (under its name in a rig of several)."""
+    if not result.rig.several:
+        return trace(result.only.record)
+    lines: list[Line] = []
+    for name, run in result.runs.items():
+        lines += [[(f"{name}:", "bold")]] + trace(run.record)
+    return lines
+
+
 def trace(record: Recorder) -> list[Line]:
     """Executed instructions, with the fast-forward jumps between them."""
     skips = [e for e in record.timeline if isinstance(e, ev.FastForwarded)]
@@ -286,17 +369,24 @@ def trace(record: Recorder) -> list[Line]:
     return lines
 
 
-def write_text(run: Run, stream: IO[str] | None = None, *, with_trace: bool = False,
+def write_text(result: Result, stream: IO[str] | None = None, *, with_trace: bool = False,
                verbose: int = 0) -> None:
     """The timeline at a verbosity (or the trace) and the summary, for people."""
-    body = trace(run.record) if with_trace else timeline(run.record, verbose) + [ending(run)]
-    write_lines([header(run)] + [line for line in body if line] + summary(run), stream)
+    body = _traces(result) if with_trace else timeline(result, verbose) + _endings(result)
+    write_lines([header(result)] + [line for line in body if line] + _summaries(result), stream)
 
 
-def header(run: Run) -> Line:
+def header(result: Result) -> Line:
     """What was simulated, and for how long, with the unit: `--until 3` is 3 ms, not 3 s."""
-    until = format_span(run.until_ms * 1000, digits=None)
-    return [(f"Simulating a {run.machine.model} from power-on until {until}", "bold")]
+    until = format_span(result.until_ms * 1000, digits=None)
+    if not result.rig.several:
+        return [(f"Simulating a {result.only.machine.model} from power-on until {until}",
+                 "bold")]
+    names = ", ".join(f"{c.name} ({c.model}, address {c.address})"
+                      for c in result.rig.controllers)
+    # the rig's name may come from its file's name: any characters (controllers' are words)
+    return [(f"Simulating rig {printable(result.rig.name)}: {names}; from power-on until "
+             f"{until}", "bold")]
 
 
 def write_vcd_cut(path: str, limit_mb: float, cut_at: int, stream: IO[str] | None = None) -> None:
@@ -312,13 +402,27 @@ def write_scenario_passed(path: str, checked: int, stream: IO[str] | None = None
                 stream)
 
 
-def to_json(run: Run) -> str:
-    """`sim --format json` (docs/simulator.md, "What sim writes")."""
-    return jsontext.dumps(run_json(run))  # json.dumps(..., indent=2), faster
+def to_json(result: Result) -> str:
+    """`sim --format json` (docs/simulator.md, "What sim writes"); a rig of several: one
+    such object per controller, by name, and the wires' edges (capped like its lists, with
+    the count left out under "truncated"; docs/rigs.md)."""
+    if not result.rig.several:
+        return jsontext.dumps(run_json(result.only))  # json.dumps(..., indent=2), faster
+    out = {
+        "rig": result.rig.name,
+        "until_ms": result.until_ms,
+        "controllers": {name: run_json(run) for name, run in result.runs.items()},
+        "edges": [{"t_ms": ms(e.t), "wire": str(e.wire), "source": str(e.wire.source),
+                   "target": str(e.wire.target), "level": e.level}
+                  for e in result.edges[:record.CAP]],
+    }
+    if result.edges_dropped:
+        out["truncated"] = {"edges": result.edges_dropped}
+    return jsontext.dumps(out)
 
 
 def run_json(run: Run) -> dict:
-    """The object of `sim --format json` (a rig's has one per controller)."""
+    """The object of `sim --format json` for one controller's run."""
     rec = run.record
     out = {
         "until_ms": run.until_ms,

@@ -1,15 +1,22 @@
 """Rigs (docs/rigs.md): several controllers on one RS-232/USB daisy chain (MS176E
-§3.2), their programs, the box, the joystick and the wires between their I/O lines.
+§3.2), their programs, the box, the joystick and the wires between their I/O lines. A lone
+program is a rig of one (Rig.of_program): every command that takes a rig runs one the same
+way, and shows the controllers' names only where there are several.
 
-    NAME.rig.toml --load (locate: positions)--> Rig + the file's own diagnostics
+    NAME.rig.toml --open (read, locate: positions)--> Rig + the file's own diagnostics
                   --checks--> the rig rules (MRnnn, in mercmac.diagnostics) and each program's
                               findings; each program checked with its controller's model
-                  --accept--> the Rig and its compiled programs, for the commands that run
+                  --accepted--> the Rig and its compiled programs, for the commands that run
                               it (sim, describe, emulate --rig, flash), or RigRefused with
                               `check`'s findings
+    NAME.mcm      --open_program--> a rig of one, its program compiled, or RigRefused
 
-Where rigs live (docs/architecture.md, "Where rigs live"): every module about rigs, by floor,
-each with what it owns. tests/project/test_rig_rooms.py holds this map to the files.
+Where rigs live (docs/architecture.md, "Where rigs live"): every module about several
+controllers, by floor, each with what it owns; in the other floors a rig's module is
+`rig.py`, or `rig_NOUN.py` where a floor has more than one. The pipelines themselves (sim,
+render, flash, describe, the emulator's server) are one for one controller or sixteen and
+live where a lone program's always did. tests/project/test_rig_rooms.py holds this map to
+the files.
 
 Data and reading:
     mercmac/rig/__init__.py        this map; `is_rig_path`, the `*.rig.toml` test of a path
@@ -19,23 +26,19 @@ Data and reading:
     mercmac/rig/presses.py         what a person may press on a rig (box buttons, joystick)
 Checking:
     mercmac/rig/checks.py          the rig rules (MR004-MR012) and `check RIG`
-    mercmac/rig/accept.py          the one way in for commands that run a rig; RigRefused
+    mercmac/rig/open.py            the one way every command opens a rig, or a lone program
 Simulating:
     mercmac/vm/wiring.py           the instant rule: machines joined by wires on one clock
-    mercmac/sim/rig.py             every controller of a rig on one simulated clock (`sim RIG`)
-    mercmac/sim/rig_ff.py          fast-forward over the passes the whole rig repeats
-    mercmac/sim/rig_scenario.py    rig scenarios: steps and expectations per controller
-    mercmac/sim/rig_vcd.py         one VCD of a rig, a scope per controller
-    mercmac/cli/run_rig.py         the work of `sim RIG`: --buttons, --joystick, output
+    mercmac/sim/rig_skip.py        fast-forward over the passes wired controllers repeat jointly
+    mercmac/sim/rig_deadlock.py    a rig whose controllers wait for good (MH008)
 Drawing:
-    mercmac/sim/rig_plot.py        the rig's picture (`sim RIG --plot`): lanes and the path
-    mercmac/render/rig.py          the merged timeline and JSON of a rig's simulation
-    mercmac/decompile/rig.py       a rig in plain words and its call graph (`describe RIG`)
+    mercmac/sim/rig_plot.py        the lanes of several controllers, and the path they draw
+    mercmac/decompile/rig.py       what the wires carry, and a call graph with a cluster each
 Hardware:
     mercmac/emulator/chain.py      a virtual daisy chain on one pty (`emulate --rig`)
     mercmac/upload/rig.py          flashing every controller of a chain; pulling a chain
 Editor:
-    mercmac/lsp/rigs.py            rig files and the programs a rig names, in the editor
+    mercmac/lsp/rig.py             rig files and the programs a rig names, in the editor
 """
 
 SUFFIX = ".rig.toml"

@@ -18,7 +18,7 @@ from mercmac.compiler.checking import Choice, Findings
 from mercmac.diagnostics import Report
 from mercmac.ops import Op
 from mercmac.commands import Mnemonic
-from mercmac.rig.load import RigFile, read_rig
+from mercmac.rig.load import RigFile
 from mercmac.rig.model import Controller, Line, LineKind, Rig, Wire
 from mercmac.source import Source, Span, read_source, split_lines
 
@@ -37,20 +37,6 @@ class Checked(NamedTuple):
     controller: Controller
     findings: Findings | None  # None: the program could not be read
     report: Report
-
-
-def check_rig_path(path: str, chosen: checking.Options = checking.Options()) -> list[Findings]:
-    """What `check` reports on the rig file at `path`: the rig file's findings first, then
-    each program's; OSError when the rig file cannot be read."""
-    rig_file = read_rig(path)
-    return check_rig(rig_file, checking.choice_for(path, chosen))
-
-
-def unreadable_programs(findings: list[Findings]) -> int:
-    """How many programs of a rig could not be read (MR002 among `findings`): an I/O
-    problem, exit 2 in every command that takes the rig, as an unreadable file is; a
-    `program` path the rig may not name is the rig's own error (MR001, exit 1)."""
-    return sum(d.rule.name == "rig-program" for f in findings for d in f.diagnostics)
 
 
 def check_rig(rig_file: RigFile, choice: Choice,
@@ -391,8 +377,8 @@ def _sure_stop(rig: Rig, checked: Checked) -> _Stop | None:
         macro = program.macros[place.slot]
         op = macro.ops[place.ip]
         if op.mnemonic == Mnemonic.WN:
-            box = op.arg in rig.box_inputs(name)
-            return None if box else _Stop(Step(op, macro.label), frozenset(raised))
+            by_hand = op.arg in rig.by_hand(name)  # a person may still come: no sure stop
+            return None if by_hand else _Stop(Step(op, macro.label), frozenset(raised))
         if not _passes(rig, name, op, macro.ops[:place.ip]):
             return None
         raised |= {n for n in range(1, 5) if _sets(op, n)}
@@ -405,7 +391,7 @@ def _passes(rig: Rig, name: str, op: Op, before: list[Op]) -> bool:
     if op.mnemonic in (Mnemonic.XN, Mnemonic.XF):
         return False  # the rest of the line may not run
     if op.mnemonic == Mnemonic.WF:  # the lines start OFF: one nothing drives stays OFF
-        return op.arg not in rig.box_inputs(name) and not rig.drivers(name, op.arg)
+        return op.arg not in rig.by_hand(name) and not rig.drivers(name, op.arg)
     return op.mnemonic != Mnemonic.RP or not _repeats_more(before)
 
 

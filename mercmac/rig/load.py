@@ -15,7 +15,7 @@ from mercmac.commands import MODELS
 from mercmac.diagnostics import Report
 from mercmac.rig import SUFFIX, is_rig_path  # noqa: F401 (is_rig_path: read here too)
 from mercmac.rig.locate import Places, locate
-from mercmac.rig.model import Controller, Line, LineKind, Rig, Wire
+from mercmac.rig.model import NAME_MAX, Controller, Line, LineKind, Rig, Wire
 from mercmac.source import Source, Span, read_bytes
 from mercmac.suggest import suggest
 
@@ -24,9 +24,6 @@ CONTROLLER_KEYS = ("address", "model", "program")
 BRANCHES = ("X", "Y", "Z")  # C-819.20 (X, Y through the Y-cable) and C-819.30 (X, Y, Z), §3.6
 BUTTONS = (1, 2, 3, 4)  # the C-170.PB box: button n on input n (MS176E §4.5.1)
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
-# The longest name of a controller or a rig: names become parts of file names (backups,
-# pulled programs), and a file name of 255 bytes or more is refused by the file system.
-NAME_MAX = 64
 # ASCII only (re.ASCII): `\d` and `\w` would take `x.out١` (an Arabic-Indic one) too
 _WIRE = re.compile(r"\s*(\w+)\.(in|out)(\d+)\s*(?:->|→)\s*(\w+)\.(in|out)(\d+)\s*\Z", re.ASCII)
 PROGRAM_SUFFIX = ".mcm"  # in any case, as mercmac.files takes `PROG.MCM`

@@ -6,11 +6,18 @@ uploader and the language server all read the same Rig.
 """
 from __future__ import annotations
 
+import os
+import re
 from dataclasses import dataclass, field
 from typing import Mapping
 
+from mercmac.commands import C863
 from mercmac.ops import TextEnum
 from mercmac.source import Span
+
+# The longest name of a controller or a rig: names become parts of file names (backups,
+# pulled programs), and a file name of 255 bytes or more is refused by the file system.
+NAME_MAX = 64
 
 
 class LineKind(TextEnum):
@@ -59,7 +66,8 @@ class Controller:
 
 @dataclass(frozen=True)
 class Rig:
-    """A rig as its file states it; `joystick` maps a branch ("X", "Y", "Z") to a controller."""
+    """A rig as its file states it; `joystick` maps a branch ("X", "Y", "Z") to a controller.
+    `lone`: the rig of one that a lone program stands for (Rig.of_program), not a rig file."""
 
     path: str
     name: str
@@ -68,6 +76,22 @@ class Rig:
     box_buttons: tuple[int, ...] = (1, 2, 3, 4)
     joystick: Mapping[str, str] = field(default_factory=dict)
     wires: tuple[Wire, ...] = ()
+    lone: bool = False
+
+    @classmethod
+    def of_program(cls, program: str, model: str | None = None, address: int = 0) -> Rig:
+        """The rig a lone program stands for where a rig may go (docs/rigs.md, "A program
+        is a rig of one"): one controller running it at `address`, of `model` (default the
+        C-863, as the simulator's), with the C-170.PB box and the joystick on it, no wires."""
+        name = name_from(os.path.splitext(os.path.basename(program))[0])
+        controller = Controller(name, address, (model or C863).upper(), program)
+        return cls(program, name, (controller,), box=name, joystick={"X": name}, lone=True)
+
+    @property
+    def several(self) -> bool:
+        """Whether the rig has more than one controller: only then are they named in what
+        mercmac shows of it (a rig of one shows as its program does)."""
+        return len(self.controllers) > 1
 
     def controller(self, name: str) -> Controller:
         """The controller called `name`; KeyError if the rig has none."""
@@ -87,3 +111,17 @@ class Rig:
     def box_inputs(self, controller: str) -> tuple[int, ...]:
         """The inputs of `controller` that buttons of the box drive (button n on input n)."""
         return self.box_buttons if controller == self.box else ()
+
+    def by_hand(self, controller: str) -> tuple[int, ...]:
+        """The inputs of `controller` a person drives: the box's buttons, and the joystick's
+        input and button (5, 6) where a joystick branch goes (MS176E §6.4 XN)."""
+        stick = (5, 6) if controller in self.joystick.values() else ()
+        return self.box_inputs(controller) + stick
+
+
+def name_from(text: str) -> str:
+    """A name (rig.load.is_name: a word of ASCII letters, digits and '_' that does not start
+    with a digit) made from TEXT, a file's or folder's name: 'my rig' -> 'my_rig',
+    '2026' -> '_2026', '' -> 'rig'."""
+    name = re.sub(r"[^A-Za-z0-9_]+", "_", text).strip("_")[:NAME_MAX] or "rig"
+    return f"_{name[:NAME_MAX - 1]}" if name[0].isdigit() else name

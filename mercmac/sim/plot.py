@@ -651,6 +651,24 @@ def _band_labels(ax, axis: TimeAxis, bands: list) -> None:
                 rotation=90, zorder=4, bbox={"facecolor": "white", "edgecolor": "gray"})
 
 
+def watches(rig) -> dict[str, PlotObserver]:
+    """One plot listener per controller of the rig, to hear its machine during the run."""
+    return {c.name: PlotObserver() for c in rig.controllers}
+
+
+def write_run(path: str, rig, watched: dict[str, PlotObserver], end_us: int,
+              title: str = "") -> None:
+    """The picture of a run into PATH, each listener closed at end_us: a lone controller's
+    lanes (`figure`), or a rig's lanes per controller and its path (rig_plot.py)."""
+    if rig.several:
+        from mercmac.sim import rig_plot
+
+        rig_plot.write(path, rig_plot.trace_of(rig, watched, end_us), title)
+        return
+    (only,) = watched.values()
+    write(path, only.close(end_us), title)
+
+
 def write(path: str, trace: Trace, title: str = "") -> None:
     """The plot into PATH (whole or not at all), its kind from the ending."""
     save(path, figure(trace, title), lambda: data(trace), title)

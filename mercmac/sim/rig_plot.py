@@ -31,21 +31,6 @@ SHORT_LEG = 0.05
 LANES = "position and macro per controller, wires, box buttons; path: start, end, direction"
 
 
-def check_target(path: str) -> None:
-    """Refuse before any simulating, as a single controller's plot does."""
-    plot.check_target(path)
-
-
-def watches(rig: Rig) -> dict[str, PlotObserver]:
-    """One plot listener per controller, to hear its machine during the run."""
-    return {c.name: PlotObserver() for c in rig.controllers}
-
-
-def listeners(watched: dict[str, PlotObserver]) -> dict[str, list]:
-    """The listeners to give the rig simulation (sim/rig.py `listeners`)."""
-    return {name: [w.on_event] for name, w in watched.items()}
-
-
 @dataclass
 class RigTrace:
     """What a rig's plot needs: each controller's Trace (us), the wires' high spans, the
@@ -61,7 +46,7 @@ class RigTrace:
 
 def trace_of(rig: Rig, watched: dict[str, PlotObserver], end_us: int) -> RigTrace:
     """Close every listener at end_us. A wire carries its driving output's level
-    (rig.py), so its lane is that output's lane: kept whole where the run's list of
+    (vm/wiring.py), so its lane is that output's lane: kept whole where the run's list of
     edges stops at its cap, and skipped passes leave it as they leave the output."""
     traces = {name: w.close(end_us) for name, w in watched.items()}
     wires = {str(w): traces[w.source.controller].outputs.get(w.source.number, [])

@@ -24,12 +24,16 @@ the nearest valid key.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 from mercmac.errors import MercmacError
 from mercmac.suggest import suggest
 from mercmac.timespec import TimeSpecError, parse_duration
 from mercmac.vm.machine import Machine
+
+if TYPE_CHECKING:
+    from mercmac.sim.simulate import Simulation
 
 CHECKS = ("outputs", "position", "macro", "running")
 
@@ -47,7 +51,7 @@ class Step:
     at_ms: int
     press: tuple[int, ...]
     release: tuple[int, ...]
-    controller: str | None = None  # a rig's controller (sim/rig_scenario.py); None: the box's
+    controller: str | None = None  # a rig's controller (`run`); None: the box's
 
 
 @dataclass(frozen=True, slots=True)
@@ -56,7 +60,7 @@ class Expect:
     start_ms: int
     end_ms: int
     checks: dict
-    controller: str | None = None  # a rig's controller (sim/rig_scenario.py)
+    controller: str | None = None  # a rig's controller (`run`)
 
     def describe(self) -> str:
         when = (f"at {self.start_ms} ms" if self.start_ms == self.end_ms
@@ -288,37 +292,96 @@ def schedule_steps(m: Machine, scenario: Scenario) -> None:
             m.schedule_input(step.at_ms, n, False)
 
 
-def check(m: Machine, expect: Expect) -> None:
-    """Run the machine through the expectation's time; raise ScenarioFailed if it never holds."""
-    m.run_until(expect.start_ms)
+def run(sim: Simulation, plan: Scenario, until_ms: int) -> int:
+    """Power on, play the steps, check every expectation in time order (all controllers on
+    the rig's one clock); the number checked. In a rig of several, a step or an expectation
+    is about the controller it names (`controller = "y"`), else the box's (or the only one):
+    a step presses only what a person can (rig.presses)."""
+    default = _default(sim, plan)
+    parts = {name: _part(sim, plan, name, default) for name in sim.machines}
+    _refuse_unknown_names(sim, plan, default)
+    _refuse_unpressable(sim, plan, default)
+    for name, part in parts.items():
+        check_names(sim.machines[name], part)
+        schedule_steps(sim.machines[name], part)
+    sim.power_on()
+    expects = sorted((e for part in parts.values() for e in part.expects),
+                     key=lambda e: (e.start_ms, e.number))
+    for expect in expects:
+        check(sim, expect)
+    sim.run_until(max(until_ms, sim.now_ms()))
+    return len(expects)
+
+
+def _default(sim: Simulation, plan: Scenario) -> str | None:
+    """Who a step or expectation without `controller` is about: the box's controller, or
+    the only one."""
+    if sim.rig.box is not None:
+        return sim.rig.box
+    return next(iter(sim.machines)) if len(sim.machines) == 1 else None
+
+
+def _part(sim: Simulation, plan: Scenario, name: str, default: str | None) -> Scenario:
+    """The steps and expectations about controller `name`, each naming it; named in the
+    messages where the rig has several."""
+    steps = [s for s in plan.steps if (s.controller or default) == name]
+    expects = [replace(e, controller=name) for e in plan.expects
+               if (e.controller or default) == name]
+    shown = f"{plan.name} ({name})" if sim.rig.several else plan.name
+    return Scenario(shown, plan.until_ms, steps, expects)
+
+
+def _refuse_unknown_names(sim: Simulation, plan: Scenario, default: str | None) -> None:
+    named = next((e for e in [*plan.steps, *plan.expects] if e.controller), None)
+    if named is not None and sim.rig.lone:
+        raise ScenarioError(f"{plan.name}: controller = {_show(named.controller)} is for "
+                            "a rig file (*.rig.toml); this run has one controller")
+    names = ", ".join(sim.machines)
+    for item in [*plan.steps, *plan.expects]:
+        name = item.controller
+        if name is None and default is None:
+            raise ScenarioError(f"{plan.name}: the rig has no box: give each step and "
+                                f"expectation its controller = \"...\" ({names})")
+        if name is not None and name not in sim.machines:
+            raise ScenarioError(f"{plan.name}: controller = \"{name}\": the rig has no "
+                                f"controller of that name ({names})")
+
+
+def _refuse_unpressable(sim: Simulation, plan: Scenario, default: str | None) -> None:
+    """A step presses or releases only what a person can (rig.presses): the box's connected
+    buttons on its controller, on inputs no wire drives; the joystick's on its branches."""
+    from mercmac.rig.presses import refusal
+
+    for step in plan.steps:
+        name = step.controller or default
+        for number in sorted({*step.press, *step.release}):
+            why = refusal(sim.rig, name, number)
+            if why:
+                raise ScenarioError(f"{plan.name}: the step at {step.at_ms} ms on {name}, "
+                                    f"input {number}: {why}")
+
+
+def check(sim: Simulation, expect: Expect) -> None:
+    """Run the rig through the expectation's time; ScenarioFailed if it never holds."""
+    m = sim.machines[expect.controller]
+    sim.run_until(expect.start_ms)
     while True:
         why = mismatch(m, expect.checks)
         if why is None:
             return
-        if m.now_ms >= expect.end_ms:
-            raise ScenarioFailed(f"{expect.describe()} failed: {why}")
-        m.run_until(min(expect.end_ms, next_change_ms(m)))
+        if sim.now_ms() >= expect.end_ms:
+            on = f" on {expect.controller}" if sim.rig.several else ""
+            raise ScenarioFailed(f"{expect.describe()}{on} failed: {why}")
+        sim.run_until(min(expect.end_ms, next_change_ms(sim)))
 
 
-def next_change_ms(m: Machine) -> float:
-    """When the checked state may change next: an event, a command, or 1 ms on while moving."""
-    t = m.next_event_ms()
-    if m.moving():
-        t = min(t, m.now_ms + 1)
-    return t if t > m.now_ms else m.now_ms + m.cycle_ms
-
-
-def run(m: Machine, scenario: Scenario, until_ms: int) -> int:
-    """Power on, play the steps, check every expectation in time order; the number checked."""
-    named = next((e for e in [*scenario.steps, *scenario.expects] if e.controller), None)
-    if named is not None:
-        raise ScenarioError(f"{scenario.name}: controller = {_show(named.controller)} is for "
-                            "a rig file (*.rig.toml); this run has one controller")
-    check_names(m, scenario)
-    schedule_steps(m, scenario)
-    m.power_on()
-    for expect in sorted(scenario.expects, key=lambda e: (e.start_ms, e.number)):
-        check(m, expect)
-    m.run_until(max(until_ms, m.now_ms))
-    return len(scenario.expects)
-
+def next_change_ms(sim: Simulation) -> float:
+    """When any controller's checked state may change next (a wire joins them): an event, a
+    command, or 1 ms on while one moves."""
+    now = sim.now_ms()
+    t = sim.next_us() / 1000
+    for m in sim.machines.values():
+        t = min(t, m.next_event_ms())
+        if m.moving():
+            t = min(t, m.now_ms + 1)
+    return t if t > now else now + min(m.cycle_ms for m in sim.machines.values())

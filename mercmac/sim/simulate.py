@@ -1,29 +1,64 @@
-"""One scripted simulation: power on, press buttons on schedule, run to a time
-(docs/simulator.md)."""
+"""One simulation: every controller of a rig on one clock, from power-on to a time
+(docs/simulator.md, docs/rigs.md). A lone program is a rig of one (Rig.of_program).
+
+Each controller is a Machine of its own (vm/machine.py) running its program with a recorder
+(sim/record.py). A controller that no wire joins to another runs alone on its own
+fast-forward (vm/optimiser.py): only its box, its joystick and its scripted presses reach
+it, and it reaches no one. The wired ones advance together, one instant at a time, by the
+instant rule of vm/wiring.py (which the virtual chain of `emulate --rig` follows too), and
+skip the passes they repeat jointly (sim/rig_skip.py). When nothing is left to happen, a rig
+whose controllers all wait for good is dead-locked (sim/rig_deadlock.py).
+"""
 from __future__ import annotations
 
+import heapq
 import time
-from dataclasses import dataclass
-from typing import IO, Iterable, Sequence
+from dataclasses import dataclass, replace
+from typing import Iterable, Mapping, Sequence
 
 from mercmac.compiler.program import Program
 from mercmac.errors import signal_of
+from mercmac.rig.model import Rig, Wire
+from mercmac.sim import rig_deadlock
+from mercmac.sim.record import CAP, Recorder
 from mercmac.timespec import Press
 from mercmac.vm.machine import Listener, Machine
 from mercmac.vm.models import Options
-from mercmac.sim.record import Recorder
+from mercmac.vm.optimiser import FastForward
+from mercmac.vm.wiring import INF, Wired
 
 DEFAULT_UNTIL_MS = 10_000  # --until defaults to 10s (docs/cli.md, "Commands")
+SLICE_S = 0.1  # wall time per slice of a run that reports progress
+
+
+@dataclass(frozen=True, slots=True)
+class Edge:
+    """A wire changed level at t (us): the driving output's new level."""
+
+    t: int
+    wire: Wire
+    level: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Hold:
+    """The joystick branch of `controller` held at `deflection` (-1..1) from start_ms to
+    end_ms (None: to the end of the run), then back to the middle."""
+
+    controller: str
+    deflection: float
+    start_ms: float
+    end_ms: float | None = None
 
 
 @dataclass(slots=True)
 class Run:
-    """What a simulation produced: the recorder, and the machine as it stands at the end."""
+    """What one controller's simulation produced: the recorder, and the machine as it stands
+    at the end."""
 
     machine: Machine
     record: Recorder
-    until_ms: int
-    vcd_cut_at: int | None = None  # us: where the VCD stopped at its size limit
+    until_ms: int | float
     interrupted: int = 0  # the signal that stopped it at until_ms (SIGINT: Ctrl-C), 0: none;
     # the record is what came so far
 
@@ -36,6 +71,30 @@ class Run:
         m = self.machine
         return {"t_ms": self.until_ms, "position": m.position(), "target": m.target,
                 "outputs": m.outputs_pattern(), "velocity": m.velocity(), "macro": m.macro}
+
+
+@dataclass(slots=True)
+class Result:
+    """What a simulation produced: each controller's Run, by name in the rig's order, and the
+    wires' edges."""
+
+    rig: Rig
+    runs: dict[str, Run]
+    edges: list[Edge]
+    until_ms: int | float
+    edges_dropped: int = 0  # past CAP edges are counted, not listed (as a run counts its lists)
+    interrupted: int = 0  # the signal that stopped the run (SIGINT: Ctrl-C), 0: none
+    vcd_cut_at: int | None = None  # us: where the VCD stopped at its size limit
+
+    @property
+    def hazards(self) -> int:
+        return sum(len(run.record.hazards) for run in self.runs.values())
+
+    @property
+    def only(self) -> Run:
+        """The one controller's Run of a rig of one (a lone program)."""
+        (run,) = self.runs.values()
+        return run
 
 
 def schedule(machine: Machine, presses: Iterable[Press]) -> None:
@@ -64,55 +123,199 @@ def machine_for(program: Program, *, model: str | None = None, cycle_ms: float =
     return machine, record
 
 
-def simulate(program: Program, *, presses: Iterable[Press] = (), until_ms: int = DEFAULT_UNTIL_MS,
-             model: str | None = None, cycle_ms: float = 1.0, options: Options | None = None,
-             trace: bool = False, vcd: IO[str] | None = None,
-             vcd_limit: int | None = None, watch=None, progress=None) -> Run:
-    """Power on at t = 0 (macro 0 starts, docs/simulator.md, "Power-on") and run to until_ms.
+class Simulation:
+    """The machines of a rig, their wires and the joystick on one clock."""
 
-    A VCD stops (a valid file) before it would pass `vcd_limit` bytes; the run goes on.
-    `watch` is one more listener (a plot) with `on_event`; it hears every event first.
-    `progress` (`update(now_ms)`, `close()`) hears the simulated time reached as the run goes.
-    Ctrl-C (KeyboardInterrupt, or Signalled: SIGTERM, SIGHUP) ends the run where it is: the
-    Run's `interrupted` is the signal.
-    """
-    dump = None
-    if vcd is not None:
-        from mercmac.sim.vcd import VcdObserver
+    def __init__(self, rig: Rig, programs: Mapping[str, Program], *, cycle_ms: float = 1.0,
+                 options: Options | None = None, trace: bool = False,
+                 listeners: Mapping[str, Sequence[Listener]] | None = None,
+                 fast_forward: FastForward | str = FastForward.ALL):
+        mode = FastForward(fast_forward)
+        self.rig = rig
+        self.machines: dict[str, Machine] = {}
+        self.records: dict[str, Recorder] = {}
+        for c in rig.controllers:
+            own = replace(options or Options(), address=c.address)  # TB reports it (§6.4 TB)
+            self.machines[c.name], self.records[c.name] = machine_for(
+                programs[c.name], model=c.model, cycle_ms=cycle_ms, options=own, trace=trace,
+                listeners=(listeners or {}).get(c.name, ()), fast_forward=mode)
+        joined = {end.controller for w in rig.wires for end in (w.source, w.target)}
+        # a controller no wire joins runs alone (its own fast-forward); the others together
+        self.alone = {n: m for n, m in self.machines.items() if n not in joined}
+        self.wired = Wired({n: m for n, m in self.machines.items() if n in joined}, rig.wires,
+                           on_edge=lambda t, wire, level: self.add_edge(Edge(t, wire, level)))
+        self.edges: list[Edge] = []
+        self.edges_dropped = 0
+        # joystick changes (t_us, order, controller, deflection): of the wired machines on the
+        # rig's clock, of each one alone on its own
+        self.holds: list[tuple[int, int, str, float]] = []
+        self.alone_holds: dict[str, list[tuple[int, int, str, float]]] = \
+            {name: [] for name in self.alone}
+        self.held_at = 0  # the last joystick change (us): activity, for a dead-lock's time
+        self.deadlocked = False
+        self.joint = None
+        if self.wired.machines and mode is FastForward.ALL and not trace:
+            from mercmac.sim.rig_skip import JointForward
 
-        dump = VcdObserver(vcd, vcd_limit)
-    listeners = [listener.on_event for listener in (watch, dump) if listener is not None]
-    machine, record = machine_for(program, model=model, cycle_ms=cycle_ms, options=options,
-                                  trace=trace, listeners=listeners)
-    schedule(machine, presses)
-    machine.power_on()
-    interrupted = 0
-    try:
-        if progress is None:
-            machine.run_until(until_ms)
+            self.joint = JointForward(self)
+
+    # ------------------------------------------------------------ what happens to it
+    def press(self, controller: str, presses: Iterable[Press]) -> None:
+        """Buttons of the box pressed on `controller`'s inputs (`--buttons`, docs/cli.md)."""
+        schedule(self.machines[controller], presses)
+
+    def hold(self, hold: Hold) -> None:
+        """The joystick deflected on `hold.controller` over a time range (§3.6)."""
+        self._at(hold.start_ms, hold.controller, hold.deflection)
+        if hold.end_ms is not None:
+            self._at(hold.end_ms, hold.controller, 0.0)
+
+    def _at(self, t_ms: float, controller: str, deflection: float) -> None:
+        into = self.alone_holds.get(controller, self.holds)
+        heapq.heappush(into, (round(t_ms * 1000), len(into), controller, deflection))
+
+    def power_on(self) -> None:
+        """All controllers power on together, at t = 0 or now (a reset of the whole rig;
+        macro 0 starts on each, §3.8.5); their outputs go off, and so do the wires."""
+        for m in self.machines.values():
+            m.power_on()
+        self.deadlocked = False
+        if self.joint is not None:
+            self.joint.seen.clear()  # passes before the reset are no pattern for after it
+        self.wired.carry(self.now_us())
+
+    # ------------------------------------------------------------ the clock
+    def run_until(self, until_ms: float) -> None:
+        """Advance every machine to until_ms: each one alone on its own, the wired ones
+        instant by instant (the module's rule); then see whether the rig is dead-locked."""
+        until = round(until_ms * 1000)
+        for name, m in self.alone.items():
+            self._run_alone(name, m, until)
+        while not self.deadlocked:
+            t = self.next_us()
+            if t >= until:
+                break
+            self._instant(t)
+            if self.joint is not None:
+                self.joint.arrive(t, until)
+        for m in self.wired.machines.values():
+            m.run(until)
+        if not self.deadlocked and self._still():
+            self.deadlocked = rig_deadlock.check(self)
+
+    def _run_alone(self, name: str, m: Machine, until: int) -> None:
+        """A controller no wire joins, to `until` on its own fast-forward; its joystick
+        changes on the way, each before any command at its time."""
+        holds = self.alone_holds[name]
+        while holds and holds[0][0] < until:
+            t, _, _, deflection = heapq.heappop(holds)
+            m.run(t)
+            m.set_joystick(deflection)
+            self.held_at = max(self.held_at, t)
+        m.run(until)
+
+    def next_us(self) -> float:
+        """The earliest event of the wired machines or of their joystick; inf when none."""
+        t = self.wired.next_us()
+        return min(t, self.holds[0][0]) if self.holds else t
+
+    @property
+    def levels(self) -> dict[Wire, bool]:
+        """Each wire's level now (its driving output's)."""
+        return self.wired.levels
+
+    def _instant(self, t: int) -> None:
+        self._joystick(t)
+        self.wired.instant(t)
+
+    def _joystick(self, t: int) -> None:
+        while self.holds and self.holds[0][0] <= t:
+            _, _, name, deflection = heapq.heappop(self.holds)
+            self.wired.at(name, t).set_joystick(deflection)
+            self.held_at = max(self.held_at, t)
+
+    def _still(self) -> bool:
+        """Whether nothing is left to happen: no machine has an event or a command due, no
+        joystick change is scripted."""
+        return (not self.holds and not any(self.alone_holds.values())
+                and all(m.next_event_ms() == INF for m in self.machines.values()))
+
+    def add_edge(self, edge: Edge) -> None:
+        """Keep an edge, up to CAP; past it, count it."""
+        if len(self.edges) < CAP:
+            self.edges.append(edge)
         else:
-            run_reporting(machine, until_ms, progress.update)
-    except KeyboardInterrupt as e:
-        interrupted, until_ms = signal_of(e), machine.now_ms
-    finally:
-        if progress is not None:
-            progress.close()
-    if dump is None:
-        return Run(machine, record, until_ms, interrupted=interrupted)
-    dump.close(round(until_ms * 1000))
-    return Run(machine, record, until_ms, dump.cut_at, interrupted)
+            self.edges_dropped += 1
+
+    def now_us(self) -> int:
+        """Where the rig's clock stands: the machines that lag (none runs ahead of it)."""
+        return min(m.now_us for m in self.machines.values())
+
+    def now_ms(self) -> float:
+        return self.now_us() / 1000
+
+    # ------------------------------------------------------------ a whole run
+    def run(self, until_ms: int, progress=None) -> Result:
+        """Power on and run to until_ms; Ctrl-C, SIGTERM or SIGHUP ends the run where it is
+        (`interrupted`: the signal). `progress` (`update(now_ms)`, `close()`) hears the
+        simulated time reached as the run goes."""
+        self.power_on()
+        try:
+            if progress is None:
+                self.run_until(until_ms)
+            else:
+                self._run_reporting(until_ms, progress.update)
+        except KeyboardInterrupt as e:
+            return self.result(self.now_ms(), interrupted=signal_of(e))
+        finally:
+            if progress is not None:
+                progress.close()
+        return self.result(until_ms)
+
+    def _run_reporting(self, until_ms: float, update) -> None:
+        """Run to until_ms in slices of about SLICE_S of wall time, calling update(now_ms)
+        after each. The slices change what is skipped at once, not what happens."""
+        step = 1.0
+        while self.now_ms() < until_ms:
+            began = time.perf_counter()
+            self.run_until(min(until_ms, self.now_ms() + step))
+            spent = time.perf_counter() - began
+            step = step * 2 if spent < SLICE_S / 2 else max(step / 2, 1.0) \
+                if spent > SLICE_S else step
+            update(self.now_ms())
+
+    def result(self, until_ms: int | float, interrupted: int = 0) -> Result:
+        runs = {name: Run(m, self.records[name], until_ms, interrupted)
+                for name, m in self.machines.items()}
+        return Result(self.rig, runs, self.edges, until_ms, self.edges_dropped, interrupted)
 
 
-SLICE_S = 0.1  # wall time per slice of a run that reports progress
+def simulate(rig: Rig, programs: Mapping[str, Program], *,
+             presses: Mapping[str, Iterable[Press]] | None = None,
+             holds: Iterable[Hold] = (), until_ms: int = DEFAULT_UNTIL_MS,
+             cycle_ms: float = 1.0, options: Options | None = None, trace: bool = False,
+             listeners: Mapping[str, Sequence[Listener]] | None = None,
+             fast_forward: FastForward | str = FastForward.ALL, progress=None) -> Result:
+    """Power every controller on at t = 0 (macro 0 starts on each, docs/simulator.md,
+    "Power-on") and run the rig to until_ms. Ctrl-C ends the run where it is: the Result
+    is marked `interrupted`."""
+    sim = Simulation(rig, programs, cycle_ms=cycle_ms, options=options, trace=trace,
+                     listeners=listeners, fast_forward=fast_forward)
+    for name, script in (presses or {}).items():
+        sim.press(name, script)
+    for hold in holds:
+        sim.hold(hold)
+    return sim.run(until_ms, progress)
 
 
-def run_reporting(machine: Machine, until_ms: float, update) -> None:
-    """Run to until_ms in slices of about SLICE_S of wall time, calling update(now_ms) after
-    each. The slices change what is skipped at once, not what happens (fastforward.py)."""
-    step = 1.0
-    while machine.now_ms < until_ms:
-        began = time.perf_counter()
-        machine.run_until(min(until_ms, machine.now_ms + step))
-        spent = time.perf_counter() - began
-        step = step * 2 if spent < SLICE_S / 2 else max(step / 2, 1.0) if spent > SLICE_S else step
-        update(machine.now_ms)
+def simulate_program(program: Program, *, presses: Iterable[Press] = (),
+                     until_ms: int = DEFAULT_UNTIL_MS, model: str | None = None,
+                     watch=None, **kw) -> Run:
+    """A lone program's run (a rig of one, Rig.of_program), for a caller that has a Program
+    and no file; `watch` is one more listener (with `on_event`, a plot's) that hears every
+    event first; the other keywords are simulate's."""
+    rig = Rig.of_program("program.mcm", model or program.target)
+    name = rig.controllers[0].name
+    listeners = {name: [watch.on_event]} if watch is not None else None
+    return simulate(rig, {name: program}, presses={name: presses}, until_ms=until_ms,
+                    listeners=listeners, **kw).only

@@ -1,11 +1,16 @@
 """A Value Change Dump of a run for GTKWave or Surfer, written with pyvcd (`--vcd`).
 
-The writer listens to the machine's events as they happen: inputs, outputs,
+A writer per controller listens to its machine's events as they happen: inputs, outputs,
 the running macro, and the position sampled every millisecond while a profile
 runs (exact at its ends). A fast-forwarded stretch is written compactly: the
 wire `vm.fast_forward` is 1 while its passes are left out, and the last pass is
 dumped in full (a day of blinking is not a million value changes).
 The dump stops cleanly before it would pass `limit` bytes; `cut_at` says when.
+
+A rig of several controllers is one dump with a scope per controller (x.box, x.axis,
+x.vm, y.box, ...). The machines' events come in time order across the rig, but a skip
+has a controller dump the last skipped pass after it while the next controller's events
+start before that; so their changes are kept and written in time order at the end.
 """
 from __future__ import annotations
 
@@ -41,7 +46,7 @@ class VcdObserver:
     def __init__(self, stream: IO[str] | None, limit: int | None = None, *,
                  writer=None, scope: str = ""):
         """`writer` and `scope`: one controller of a rig writing into a shared dump (its
-        scopes under `scope`, sim/rig_vcd.py); else a dump of its own on `stream`."""
+        scopes under `scope`, Dump); else a dump of its own on `stream`."""
         self.out = _Counted(stream) if writer is None else _Counted(None)
         self.limit = limit
         self.cut_at: int | None = None  # us: where the dump stopped at the size limit
@@ -115,18 +120,29 @@ class VcdObserver:
                 case ev.OutputsChanged(at, pattern):
                     changes += [(at, var, pattern >> i & 1)
                                 for i, var in enumerate(self.outputs)]
-        if skip.shift or not ff.plain(skip.shape):
+        moves = skip.shift or not ff.plain(skip.shape)
+        if moves:
             changes += self._last_pass(skip)
         for t, var, value in sorted(changes, key=lambda change: change[0]):
             self.writer.change(var, t, value)
             self.last = max(self.last, t)
+        if moves:  # a move running across the skip's end runs on as the copy of the one
+            # before it (the machine moved its profile so: Axis.translate); its samples go
+            # on after what the last pass wrote
+            span, moved = skip.t_to - skip.t, skip.passes * skip.shift
+            self.segments = tuple(seg.moved(span, moved) for seg in self.segments)
+            self.sampled_to = max(skip.t_to, self.last)
 
     def _last_pass(self, skip: ev.FastForwarded) -> list:
         """The position in a shifted skip: where its passes start and, sampled, the moves of
         its last pass (copies of the stepped pass before the skip, `shift` further on)."""
         last = skip.t + (skip.passes - 1) * skip.period
-        at_last = skip.position + (skip.passes - 1) * skip.shift
-        changes = [(skip.t, self.position, skip.position), (last, self.position, at_last)]
+        # where the stage is as the passes start: on its way (the skip's `position` is the
+        # target it runs to), or at rest on it; rounded as a sample is, at each end (a
+        # position half-way between counts rounds to the even one: not by `shift`)
+        x = _position(self.segments, skip.t) if self.segments else skip.position
+        at_last = round(x + (skip.passes - 1) * skip.shift)
+        changes = [(skip.t, self.position, round(x)), (last, self.position, at_last)]
         dt, dx = (skip.passes - 1) * skip.period, (skip.passes - 1) * skip.shift
         for move in [m for m in self.moves if skip.t - skip.period <= m.t < skip.t]:
             changes.append((move.t + skip.period + dt, self.target, move.target + skip.shift + dx))
@@ -165,3 +181,63 @@ def _position(segments: tuple, t: float) -> float:
         if t < seg.t1:
             return seg.x(t)
     return segments[-1].x(segments[-1].t1)
+
+
+class _Kept:
+    """What a controller's VcdObserver writes to in a rig's dump: variables on the real
+    writer, changes kept for the end."""
+
+    def __init__(self, writer: VCDWriter, changes: list):
+        self.writer, self.changes = writer, changes
+
+    def register_var(self, *args, **kwargs):
+        return self.writer.register_var(*args, **kwargs)
+
+    def change(self, var, t: int, value) -> None:
+        self.changes.append((t, len(self.changes), var, value))
+
+    def close(self, t: int) -> None:
+        pass
+
+
+class Dump:
+    """The dump of a run: `listeners()` per controller, then `close(end_us)`. One controller
+    (a lone program) writes as it goes, with its scopes at the top (box, axis, vm); several
+    write a scope each, in time order at the end."""
+
+    def __init__(self, stream: IO[str], names: list[str], limit: int | None = None):
+        self.limit = limit
+        self.changes: list = []
+        if len(names) == 1:
+            self.out, self.writer = None, None
+            self.observers = {names[0]: VcdObserver(stream, limit)}
+            return
+        self.out = _Counted(stream)
+        self.writer = VCDWriter(self.out, timescale="1 us", date="", comment="mercmac sim (rig)")
+        kept = _Kept(self.writer, self.changes)
+        self.observers = {name: VcdObserver(None, writer=kept, scope=name) for name in names}
+        self._cut_at: int | None = None
+
+    @property
+    def cut_at(self) -> int | None:
+        """Where the dump stopped at its size limit (us); None: it holds the whole run."""
+        if self.writer is None:
+            (only,) = self.observers.values()
+            return only.cut_at
+        return self._cut_at
+
+    def listeners(self) -> dict[str, list]:
+        return {name: [o.on_event] for name, o in self.observers.items()}
+
+    def close(self, end_us: int) -> None:
+        for observer in self.observers.values():
+            observer.close(end_us)  # samples each profile to the end
+        if self.writer is None:
+            return
+        self.changes.sort(key=lambda c: (c[0], c[1]))
+        for t, _, var, value in self.changes:
+            if self.limit is not None and self.out.written + CLOSING > self.limit:
+                self._cut_at = t
+                break
+            self.writer.change(var, t, value)
+        self.writer.close(self._cut_at if self._cut_at is not None else end_us)

@@ -29,7 +29,7 @@ from mercmac.upload.transport import DEFAULT_BAUD, Timing, Transport
 
 if TYPE_CHECKING:
     from mercmac.compiler import Compilation
-    from mercmac.rig.accept import Accepted
+    from mercmac.rig.open import Accepted
     from mercmac.rig.model import Controller as Member, Rig
 
 
@@ -195,7 +195,7 @@ def _read(path: str, watch: RigWatch) -> "Accepted":
     """The rig and its programs, checked as `check RIG` checks it (rig.accept: the rig rules
     and every program with its controller's model); Refused, after `watch.refused_rig`,
     when that finds errors. InputError (exit 2) when it or a program cannot be read."""
-    from mercmac.rig.accept import ProgramsUnread, RigRefused, accept
+    from mercmac.rig.open import ProgramsUnread, RigRefused, accept
 
     try:
         return accept(path)

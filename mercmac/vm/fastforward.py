@@ -385,7 +385,7 @@ class Visit:
 
 class Pass(NamedTuple):
     """What shifted_passes reads of the pass that ended at an anchor (a Visit has it too; a
-    rig's joint skip, sim/rig_ff.py, has no Visit of its own)."""
+    rig's joint skip, sim/rig_skip.py, has no Visit of its own)."""
 
     wake: int  # when the pass ended, us
     position: int  # the target there

@@ -158,6 +158,8 @@ class Machine:
     wake: int = unkeyed("the clock: Visit.wake, from which the period of a pass comes")
     hazards: HazardLog = unkeyed("each is reported once: one in a pass makes its shape "
                                  "unrepeatable")
+    active: int = unkeyed("a time: the last instant it did anything (a command or a hardware "
+                          "event), when a rig that waits for good went still (sim/rig_deadlock.py)")
     table_done: float = unkeyed("a time: inf unless a JT table is being made, and then it "
                                 "bounds a skip as a hardware event (_next_hardware)")
 
@@ -179,6 +181,7 @@ class Machine:
         self.optimiser = Optimiser(self, FastForward(fast_forward))
         self.chunks, self._lines = {}, None
         self.hazards = HazardLog()
+        self.active = 0
         self.deflection = None  # hardware: a reset leaves the joystick where it is
         self._reset_state()
         if program is not None:
@@ -405,16 +408,20 @@ class Machine:
         so that an input set next happens there."""
         end = until + 1 if through else until  # whole us: due before until + 1 is due by until
         self.optimiser.running_to(end)
+        active = None
         while True:
             t_hw = self._next_hardware()
             t_ins = self.wake if self.chunk is not None and self.block is None else INF
             if t_hw <= t_ins and t_hw < end:  # inputs apply before a command at the same time
-                self._hardware(int(t_hw))
+                active = int(t_hw)
+                self._hardware(active)
             elif t_ins < end:
-                self.clock.now = t_ins
+                self.clock.now = active = t_ins
                 self.step()
             else:
                 break
+        if active is not None:
+            self.active = active
         self.clock.now = max(self.clock.now, until)
 
     def step(self) -> None:
@@ -787,7 +794,7 @@ class Machine:
     def skip_passes(self, t: int, passes: int, period: int, shape: tuple, position: int,
                     shift: int, spent: Mapping[tuple[int, int], int]) -> None:
         """Skip `passes` passes that a rig found repeating jointly from the instant t
-        (sim/rig_ff.py), each `period` us long and `shift` counts further on than the last,
+        (sim/rig_skip.py), each `period` us long and `shift` counts further on than the last,
         each counting the RP at (slot, ip) down by spent[(slot, ip)]. A rig skips between two
         instants, so the clock and a wait's start move on too; a jump of its own (_jump) skips
         from a loop anchor, before the clock reaches the next command."""
@@ -815,7 +822,7 @@ class Machine:
 
     def _joint_state(self, t: int) -> tuple:
         """The state key as a rig compares it at the instant t (Optimiser.joint_key): which RPs
-        count, not by how much (the rig counts them down itself, sim/rig_ff.py), and a wait
+        count, not by how much (the rig counts them down itself, sim/rig_skip.py), and a wait
         by how long it has waited, up to a cycle (its start matters only to the first cycle
         after it). Machine is the one module that knows where fields stand in its key."""
         key = list(self._state_key(None))
@@ -882,7 +889,8 @@ class Machine:
         self.tell(event)
 
     def tell(self, event: object) -> None:
-        """Have the listeners hear `event`. From outside (a rig's skip or deadlock, sim/rig.py)
+        """Have the listeners hear `event`. From outside (a rig's skip or dead-lock,
+        sim/rig_skip.py, sim/rig_deadlock.py)
         the optimiser does not log it: it is no effect of one of this machine's passes."""
         for listener in self.listeners:
             listener(event)

@@ -190,7 +190,7 @@ class Optimiser:
         return self.log[start - self.log_base:end - self.log_base]
 
     def joint_key(self, t: int) -> tuple | None:
-        """The machine's part of a rig's joint key at the instant t (sim/rig_ff.py): its shift
+        """The machine's part of a rig's joint key at the instant t (sim/rig_skip.py): its shift
         key (_shift_key) over the state a rig compares (Machine._joint_state), its input lines
         (the wires' levels) and its next command relative to t. None when a trigger pulse is
         on or a JT table is being made (each ends at a time of its own), or _shift_key has

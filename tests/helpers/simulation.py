@@ -35,3 +35,36 @@ def states(program: Program, mode: str, checkpoints: list[int], presses=(), opti
 def skips(record) -> list[ev.FastForwarded]:
     """The skips of a run, in time order."""
     return [e for e in record.timeline if isinstance(e, ev.FastForwarded)]
+
+
+def vcd_values(text: str, var: str = "position") -> dict[tuple[str, int], int]:
+    """The values a VCD gives the integer variable `var` of each scope, by (scope, time):
+    ('axis', t) for a program's dump, ('x.axis', t) for controller x of a rig's."""
+    import re
+
+    codes, scopes = {}, []
+    for line in text.split("\n"):
+        if (opened := re.match(r"\$scope module (\S+) \$end", line)):
+            scopes.append(opened.group(1))
+        elif line.startswith("$upscope"):
+            scopes.pop()
+        elif (declared := re.match(rf"\$var integer 32 (\S+) {var} \$end", line)):
+            codes[declared.group(1)] = ".".join(scopes)
+    t, values = 0, {}
+    for line in text.split("\n"):
+        if line.startswith("#"):
+            t = int(line[1:])
+        elif line.startswith("b") and line.split()[-1] in codes:
+            bits, code = line[1:].split()
+            value = int(bits, 2)
+            values[(codes[code], t)] = value - (1 << 32) if value >> 31 else value
+    return values
+
+
+def same_samples(fast: dict, stepped: dict) -> int:
+    """How many values a fast-forwarded dump gives at times the stepped one has too; an
+    AssertionError names the first that differs (a skip leaves passes out, never wrong)."""
+    common = [key for key in fast if key in stepped]
+    wrong = [(key, fast[key], stepped[key]) for key in common if fast[key] != stepped[key]]
+    assert not wrong, f"{len(wrong)} values differ from stepping, first {wrong[:3]}"
+    return len(common)

@@ -282,7 +282,7 @@ async def test_a_broken_rig_shows_what_check_says(client: LanguageClient, rig: P
 def test_a_rig_check_that_fails_is_said_at_1_1(monkeypatch, tmp_path):
     """A bug in the rig checks is a diagnostic on the rig, as a compiler bug is on a file."""
     from mercmac.compiler.checking import choice_for
-    from mercmac.lsp import rigs
+    from mercmac.lsp import rig
     from mercmac.rig import checks
     from mercmac.source import Source
 
@@ -290,6 +290,6 @@ def test_a_rig_check_that_fails_is_said_at_1_1(monkeypatch, tmp_path):
         raise RuntimeError("a bug")
 
     monkeypatch.setattr(checks, "check_rig", broken)
-    (found,) = rigs.rig_diagnostics(Source(str(tmp_path / "r.rig.toml"), ""), choice_for(None))
+    (found,) = rig.rig_diagnostics(Source(str(tmp_path / "r.rig.toml"), ""), choice_for(None))
     assert (found.rule.code, found.span.line, found.span.column) == ("MR001", 1, 1)
     assert "internal error while checking this rig (RuntimeError: a bug)" in found.message

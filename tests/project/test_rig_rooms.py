@@ -2,7 +2,7 @@
 mercmac/rig/__init__.py maps every module about rigs, and the map names only modules that exist.
 
 A module is about rigs when it is in mercmac/rig/, when "rig" or "rigs" is a word of its file
-name (`rig_ff.py`, `run_rig.py`; not `trigger.py`), or when it is one of the rig rooms whose
+name (`rig_skip.py`, `rig.py`; not `trigger.py`), or when it is one of the rig rooms whose
 name does not say so (ROOMS_NAMED_OTHERWISE)."""
 from __future__ import annotations
 
@@ -11,9 +11,9 @@ import re
 
 from helpers.paths import PACKAGE, ROOT
 
-# rig rooms whose file names carry no "rig": the instant rule, the virtual chain, the editor's
-ROOMS_NAMED_OTHERWISE = ("mercmac/vm/wiring.py", "mercmac/emulator/chain.py",
-                         "mercmac/lsp/rigs.py")
+# rig rooms whose file names carry no "rig": the instant rule (the VM knows wires, not rigs),
+# the virtual chain (served by `emulate --addresses` with no rig too)
+ROOMS_NAMED_OTHERWISE = ("mercmac/vm/wiring.py", "mercmac/emulator/chain.py")
 
 
 def _named_in_the_map() -> set[str]:

@@ -186,15 +186,15 @@ def _history(tmp: Path, name: str) -> str:
 def _sim(tmp: Path, name: str) -> str:
     """`sim RIG`'s text for a rig of that name: a rig's name defaults to its file's, and the
     header shows it (its controllers' names are words: the rig reader refuses others)."""
-    from mercmac.render import rig as render
-    from mercmac.rig.accept import accept
-    from mercmac.sim.rig import simulate_rig
+    from mercmac.render import sim as render
+    from mercmac.rig.open import accept
+    from mercmac.sim.simulate import simulate
 
     accepted = accept(str(_rig(tmp / "rig", "x")))
     rig = replace(accepted.rig, name=name)
     programs = {n: c.program for n, c in accepted.programs.items()}
     shown = io.StringIO()
-    render.write_text(simulate_rig(rig, programs, until_ms=50), shown)
+    render.write_text(simulate(rig, programs, until_ms=50), shown)
     return shown.getvalue()
 
 

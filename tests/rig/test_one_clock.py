@@ -13,7 +13,7 @@ from mercmac.compiler import compile_file
 from mercmac.emulator.chain import Chain, Wiring
 from mercmac.emulator.virtual import VirtualController
 from mercmac.rig.load import read_rig
-from mercmac.sim.rig import simulate_rig
+from mercmac.sim.simulate import simulate
 from mercmac.vm import events as ev
 
 UNTIL_MS = 3_000
@@ -28,7 +28,7 @@ def _inputs(events: list) -> list[tuple[int, int, bool]]:
 
 
 def _simulated(rig, programs) -> dict[str, list]:
-    run = simulate_rig(rig, programs, until_ms=UNTIL_MS, fast_forward=False)
+    run = simulate(rig, programs, until_ms=UNTIL_MS, fast_forward="off")
     return {name: _inputs(r.record.events) for name, r in run.runs.items()}
 
 

@@ -1,5 +1,5 @@
 """`check`'s sure dead-lock on an input nothing drives (MR011, mercmac/rig/checks.py) against
-the rig simulator (MH008, sim/rig.py): on random programs of two wired
+the rig simulator (MH008, sim/rig_deadlock.py): on random programs of two wired
 controllers, whenever `check` says the rig dead-locks for sure, `sim` finds the dead-lock."""
 from __future__ import annotations
 
@@ -14,9 +14,9 @@ from hypothesis import strategies as st
 from helpers.budgets import budget
 from helpers.rigs import rig_of
 from mercmac.compiler import checking, compile_file
-from mercmac.rig.checks import check_rig_path
+from mercmac.rig.open import open_rig
 from mercmac.rig.load import read_rig
-from mercmac.sim.rig import simulate_rig
+from mercmac.sim.simulate import simulate
 
 WIRES = '"x.out1 -> y.in1", "y.out2 -> x.in2"'
 OPS = ["WN1", "WN2", "WN3", "WN4", "WF2", "WF3", "CN1", "CN2", "CF1", "CF2", "WA3", "XN3",
@@ -27,7 +27,7 @@ boxes = st.sampled_from(["", 'box = "x"\nbox_buttons = [3]\n', 'box = "y"\n'])
 
 def sure_dead_lock(path: Path) -> bool | None:
     """Whether `check` reports a sure dead-lock on an undriven input; None: check errors."""
-    found = [d for f in check_rig_path(str(path), checking.options()) for d in f.diagnostics]
+    found = [d for f in open_rig(str(path), checking.options()).findings for d in f.diagnostics]
     if any(d.severity.name == "ERROR" for d in found):
         return None
     return any(d.rule.code == "MR011" and d.message.startswith("dead-lock:") for d in found)
@@ -36,7 +36,7 @@ def sure_dead_lock(path: Path) -> bool | None:
 def simulated_dead_lock(path: Path) -> bool:
     rig = read_rig(str(path)).rig
     programs = {c.name: compile_file(c.program, target=c.model).program for c in rig.controllers}
-    result = simulate_rig(rig, programs, until_ms=60_000)
+    result = simulate(rig, programs, until_ms=60_000)
     return any(h.rule == "rig-deadlock" for r in result.runs.values() for h in r.record.hazards)
 
 

@@ -129,7 +129,7 @@ def test_a_rig_file_that_cannot_be_read_is_said_as_check_says_it(tmp_path):
 def test_accepted_programs_are_each_controllers_own_compilation(tmp_path):
     """Two controllers may run one file: each gets it compiled with its own model, the very
     compilation `check` made (not a second one)."""
-    from mercmac.rig.accept import accept
+    from mercmac.rig.open import accept
 
     program = "autostart { MR 100, WS 0, CN 1 }\n"  # no `target`: the rig's model decides
     toml = controllers().replace('"y.mcm"', '"x.mcm"').replace(

@@ -6,8 +6,8 @@ import pytest
 
 from mercmac.compiler import checking
 from mercmac.diagnostics import RULES
-from mercmac.rig.accept import accept
-from mercmac.rig.checks import check_rig_path
+from mercmac.rig.open import accept
+from mercmac.rig.open import open_rig
 from helpers.rigs import DEAD_X, DEAD_Y, RASTER, WIRES, X, Y, controllers, write_rig
 
 RIG_CODES = {r.code for r in RULES if r.code.startswith("MR")}
@@ -16,7 +16,7 @@ RIG_CODES = {r.code for r in RULES if r.code.startswith("MR")}
 def _found(path, **options) -> list[tuple[str, str, int, int, str]]:
     """(code, file name, line, column, message) of every diagnostic `check` reports."""
     return [(d.rule.code, d.file.rsplit("/", 1)[-1], d.span.line, d.span.column, d.message)
-            for findings in check_rig_path(str(path), checking.options(**options))
+            for findings in open_rig(str(path), checking.options(**options)).findings
             for d in findings.diagnostics]
 
 

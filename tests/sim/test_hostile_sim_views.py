@@ -125,11 +125,11 @@ def test_an_empty_plot_name_is_refused_by_the_command_as_run(write, tmp_path):
 
 def _trace(source: str, buttons: str, until_ms: int):
     from mercmac.sim import plot
-    from mercmac.sim.simulate import simulate
+    from mercmac.sim.simulate import simulate_program
     from mercmac.timespec import parse_buttons
 
     watch = plot.PlotObserver()
-    simulate(program_of(source), presses=parse_buttons(buttons), until_ms=until_ms, watch=watch)
+    simulate_program(program_of(source), presses=parse_buttons(buttons), until_ms=until_ms, watch=watch)
     return watch.close(until_ms * 1000)
 
 

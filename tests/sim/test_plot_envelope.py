@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from helpers.compiling import program_of
 from mercmac.sim.plot import PlotObserver, figure
-from mercmac.sim.simulate import simulate
+from mercmac.sim.simulate import simulate_program
 
 # out 3000, back 2900: each pass sweeps 3000 counts and ends 100 further on
 SAW = "macro m { MR 3000, WS 0, MR -2900, WS 0, goto m }\nautostart { goto m }\n"
@@ -15,7 +15,7 @@ SAW = "macro m { MR 3000, WS 0, MR -2900, WS 0, goto m }\nautostart { goto m }\n
 
 def traced(text: str, until_ms: int):
     watch = PlotObserver()
-    run = simulate(program_of(text), until_ms=until_ms, watch=watch)
+    run = simulate_program(program_of(text), until_ms=until_ms, watch=watch)
     return watch.close(until_ms * 1000), run
 
 

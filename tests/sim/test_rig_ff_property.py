@@ -5,6 +5,7 @@ hazards and final state whether the rig's repeating passes are skipped or steppe
 when the wires join lines the programs never set, so that no pass changes a wire."""
 from __future__ import annotations
 
+import io
 import shutil
 import tempfile
 from pathlib import Path
@@ -16,21 +17,31 @@ from hypothesis import strategies as st
 
 from helpers.budgets import budget
 from helpers.rigs import rig_of
+from helpers.simulation import same_samples, vcd_values
 from mercmac.compiler import compile_file
 from mercmac.rig.load import read_rig
 from mercmac.sim import record as record_module
-from mercmac.sim.rig import simulate_rig
+from mercmac.sim.simulate import simulate
+from mercmac.sim.vcd import Dump
 from mercmac.vm import events as ev
 
 WIRES = '"x.out1 -> y.in1", "y.out2 -> x.in2"'
 QUIET = '"x.out3 -> y.in3", "y.out4 -> x.in4"'  # lines the programs never set: no edge
 
 
-def run(path: Path, until_ms: int, fast_forward: bool):
+def run(path: Path, until_ms: int, fast_forward: bool, dumped: dict | None = None):
+    """The rig run to until_ms, skipping or stepping; its VCD's positions into `dumped`."""
     rig = read_rig(str(path)).rig
     programs = {c.name: compile_file(c.program, target=c.model).program for c in rig.controllers}
+    out = io.StringIO()
+    dump = Dump(out, [c.name for c in rig.controllers])
     with mock.patch.object(record_module, "CAP", 10**7):  # every event listed: comparable
-        return simulate_rig(rig, programs, until_ms=until_ms, fast_forward=fast_forward)
+        result = simulate(rig, programs, until_ms=until_ms, listeners=dump.listeners(),
+                          fast_forward="all" if fast_forward else "off")
+    dump.close(until_ms * 1000)
+    if dumped is not None:
+        dumped.update(vcd_values(out.getvalue()))
+    return result
 
 
 def outcome(result) -> dict:
@@ -75,9 +86,11 @@ def test_a_wired_rig_skipped_gives_what_stepping_gives(xs, ys, x_tail, y_tail, p
     try:
         path = rig_of(folder, f"[MC00] {prologue}EM1\n[MC01] {','.join(xs)},{x_tail}\n",
                       f"[MC00] EM1\n[MC01] {','.join(ys)},{y_tail}\n", wires)
-        fast = run(path, until_ms, True)
-        plain = run(path, until_ms, False)
+        fast_vcd, plain_vcd = {}, {}
+        fast = run(path, until_ms, True, fast_vcd)
+        plain = run(path, until_ms, False, plain_vcd)
         assert outcome(fast) == outcome(plain)
+        same_samples(fast_vcd, plain_vcd)  # a move across a skip is sampled as stepping has it
     finally:
         shutil.rmtree(folder)
 
@@ -86,9 +99,11 @@ def test_a_rig_that_moves_on_the_way_skips_together(tmp_path):
     # x reports and steps on the way, 1 count a pass, and pulses y, which steps along
     path = rig_of(tmp_path, "[MC00] EM1\n[MC01] TT,MR1,CN1,WA1,CF1,RP,RP\n",
                   "[MC00] EM1\n[MC01] WN1,MR1,TP,WF1,RP,RP\n", WIRES)
-    fast, plain = run(path, 20_000, True), run(path, 20_000, False)
+    fast_vcd, plain_vcd = {}, {}
+    fast, plain = run(path, 20_000, True, fast_vcd), run(path, 20_000, False, plain_vcd)
     assert outcome(fast) == outcome(plain)
     assert skipped(fast) > 1000
+    assert same_samples(fast_vcd, plain_vcd) > 10
 
 
 def test_passes_that_change_no_wire_skip_together(tmp_path):

@@ -1,6 +1,6 @@
 """`sim RIG --plot`: a lane per axis, the wires' levels, the path picture.
 
-A two-axis raster runs on the rig simulator (sim/rig.py): X sweeps a line and raises
+A two-axis raster runs on the rig simulator (sim/simulate.py): X sweeps a line and raises
 out1, Y steps one row on in1 and raises out2, X sweeps back on in2. The figure is read
 back as drawn: one position lane per controller, a lane per wire equal to the wire's
 edges, and a path whose points are the simulated positions, with a start and an end.
@@ -21,8 +21,8 @@ import numpy as np  # noqa: E402  (the plot extra's)
 from matplotlib.quiver import Quiver  # noqa: E402
 
 from mercmac.rig.model import Controller, Line, LineKind, Rig, Wire  # noqa: E402
-from mercmac.sim import rig_plot  # noqa: E402
-from mercmac.sim.rig import simulate_rig  # noqa: E402
+from mercmac.sim import plot, rig_plot  # noqa: E402
+from mercmac.sim.simulate import simulate  # noqa: E402
 
 SWEEP = ("target C-663\nautostart { SV 20000, SA 200000\n goto sweep }\n"
          "macro sweep {\n  MR 20000, WS 10, CN 1, WN 2, CF 1, WF 2\n"
@@ -45,12 +45,16 @@ def _rig(*names: str, box: str | None = None) -> Rig:
                wires=(_wire("x.out1", "y.in1"), _wire("y.out2", "x.in2")))
 
 
+def _listeners(watches: dict) -> dict:
+    return {name: [w.on_event] for name, w in watches.items()}
+
+
 def _run(rig: Rig, until_ms: int = UNTIL_MS, **kw):
-    """The rig simulated with a plot listener on every controller: (RigRun, RigTrace)."""
+    """The rig simulated with a plot listener on every controller: (Result, RigTrace)."""
     programs = {"x": program_of(SWEEP), "y": program_of(STEP), "z": program_of(LIFT)}
-    watches = rig_plot.watches(rig)
-    run = simulate_rig(rig, {c.name: programs[c.name] for c in rig.controllers},
-                       until_ms=until_ms, listeners=rig_plot.listeners(watches), **kw)
+    watches = plot.watches(rig)
+    run = simulate(rig, {c.name: programs[c.name] for c in rig.controllers},
+                       until_ms=until_ms, listeners=_listeners(watches), **kw)
     return run, rig_plot.trace_of(rig, watches, until_ms * 1000)
 
 
@@ -131,7 +135,7 @@ def test_the_raster_reads_as_rows_swept_and_stepped(raster):
 def test_fast_forward_draws_the_same_picture(raster):
     """Skipped passes are drawn as the copies they are: the lanes, the wires and the path
     are those of the run stepped pass by pass."""
-    _, stepped = _run(_rig("x", "y"), fast_forward=False)
+    _, stepped = _run(_rig("x", "y"), fast_forward="off")
     _, skipped = raster
     assert skipped.traces["y"].skips  # the rig did skip passes
     assert np.allclose(rig_plot.path(skipped), rig_plot.path(stepped))
@@ -170,8 +174,8 @@ def test_a_deadlock_is_marked_on_both_lanes():
               wires=(_wire("x.out1", "y.in1"), _wire("y.out2", "x.in2")))
     wait = "target C-663\nautostart {{ WN {n}, CN {m} }}\n"  # each waits for the other
     programs = {"x": program_of(wait.format(n=2, m=1)), "y": program_of(wait.format(n=1, m=2))}
-    watches = rig_plot.watches(rig)
-    simulate_rig(rig, programs, until_ms=1000, listeners=rig_plot.listeners(watches))
+    watches = plot.watches(rig)
+    simulate(rig, programs, until_ms=1000, listeners=_listeners(watches))
     rt = rig_plot.trace_of(rig, watches, 1_000_000)
     axes = _axes(_figure(rt))
     for name in ("x", "y"):

@@ -1,4 +1,4 @@
-"""A rig on one clock (sim/rig.py): wires at the same instant, the raster
+"""A rig on one clock (sim/simulate.py): wires at the same instant, the raster
 example rasters, a rig built to dead-lock reports it with both macros, joint fast-forward
 gives what stepping gives, and the joystick drives its branch's controller."""
 from __future__ import annotations
@@ -12,8 +12,8 @@ from helpers.rigs import RASTER, rig_of, rig_of_one
 from mercmac.compiler import compile_file
 from mercmac.render import explain
 from mercmac.rig.load import read_rig
-from mercmac.sim.rig import Hold, simulate_rig
-from mercmac.sim.simulate import simulate
+from mercmac.sim.simulate import Hold, simulate
+from mercmac.sim.simulate import simulate_program
 from mercmac.timespec import parse_buttons
 from mercmac.vm import events as ev
 
@@ -24,7 +24,7 @@ def run(path: Path, **kw):
     rig = read_rig(str(path)).rig
     assert rig is not None
     programs = {c.name: compile_file(c.program, target=c.model).program for c in rig.controllers}
-    return simulate_rig(rig, programs, **kw)
+    return simulate(rig, programs, **kw)
 
 
 def events(result, name: str, kind: type) -> list:
@@ -46,7 +46,7 @@ def test_an_output_reaches_the_wired_input_at_the_same_instant(tmp_path):
 
 
 def test_the_raster_example_rasters():
-    result = run(RASTER, presses=START, until_ms=12_000, fast_forward=False)
+    result = run(RASTER, presses=START, until_ms=12_000, fast_forward="off")
     x_moves = [e.target for e in events(result, "x", ev.MoveStarted)]
     y_moves = [e.target for e in events(result, "y", ev.MoveStarted)]
     assert x_moves[:4] == [20000, 0, 20000, 0]  # X sweeps a line and back
@@ -174,7 +174,7 @@ def outcome(result) -> dict:
 @pytest.mark.parametrize("until_ms", [30_000, 61_234, 200_000])
 def test_joint_fast_forward_equals_stepping(until_ms):
     fast = run(RASTER, presses=START, until_ms=until_ms)
-    plain = run(RASTER, presses=START, until_ms=until_ms, fast_forward=False)
+    plain = run(RASTER, presses=START, until_ms=until_ms, fast_forward="off")
     assert outcome(fast) == outcome(plain)
     assert events(fast, "y", ev.FastForwarded) and not events(plain, "y", ev.FastForwarded)
 
@@ -182,7 +182,7 @@ def test_joint_fast_forward_equals_stepping(until_ms):
 def test_an_idle_rig_polling_with_a_counted_loop_skips_exactly():
     # no button: X polls button 1 every 50 ms (an RP counting down), Y waits on in1
     fast = run(RASTER, until_ms=200_000)
-    plain = run(RASTER, until_ms=200_000, fast_forward=False)
+    plain = run(RASTER, until_ms=200_000, fast_forward="off")
     assert outcome(fast) == outcome(plain)
     assert fast.runs["x"].machine.counters == plain.runs["x"].machine.counters
     assert events(fast, "x", ev.FastForwarded)
@@ -196,7 +196,7 @@ def test_a_skip_stops_before_a_counted_loop_ends(tmp_path):
                   "macro echo { WN 1, CN 3, WF 1, CF 3, goto echo }\nautostart { goto echo }\n",
                   '"x.out1 -> y.in1", "x.out2 -> y.in2"')
     fast = run(path, until_ms=20_000)
-    plain = run(path, until_ms=20_000, fast_forward=False)
+    plain = run(path, until_ms=20_000, fast_forward="off")
     assert outcome(fast) == outcome(plain)
     assert events(fast, "x", ev.FastForwarded)
     (blinks_over,) = [e for e in fast.runs["x"].record.outputs if e.pattern == 2]
@@ -207,7 +207,7 @@ def test_a_button_during_the_scan_bounds_the_skip():
     # button 3 stops the scan after the current pair of lines: stepping and skipping agree
     presses = {"x": parse_buttons("1@0-100ms,3@40s-45s")}
     fast = run(RASTER, presses=presses, until_ms=90_000)
-    plain = run(RASTER, presses=presses, until_ms=90_000, fast_forward=False)
+    plain = run(RASTER, presses=presses, until_ms=90_000, fast_forward="off")
     assert outcome(fast) == outcome(plain)
     assert fast.runs["x"].machine.macro is not None and fast.runs["y"].final()["target"] < 45_000
 
@@ -247,7 +247,7 @@ def test_skipping_passes_that_change_no_wire_costs_nothing_per_pass(tmp_path):
     long, long_calls = calls_of(path, 1500 * 86_400_000)
     assert long_calls <= short_calls + 1_000
     program = compile_file(str(tmp_path / "s.mcm")).program
-    alone = simulate(program, until_ms=1500 * 86_400_000)
+    alone = simulate_program(program, until_ms=1500 * 86_400_000)
     ours = long.runs["s"]  # what `sim FILE` says of the program, the rig says of it
     assert ours.final() == alone.final()
     assert (ours.record.outputs, ours.record.dropped) == (alone.record.outputs,

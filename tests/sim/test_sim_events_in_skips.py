@@ -17,7 +17,7 @@ from helpers.compiling import program_of
 from helpers.rigs import RASTER
 from mercmac.compiler import compile_file
 from mercmac.rig.load import read_rig
-from mercmac.sim.rig import simulate_rig
+from mercmac.sim.simulate import simulate
 from mercmac.timespec import parse_buttons
 from mercmac.cli import main
 from mercmac.compiler.program import Macro, Op, Program
@@ -155,8 +155,8 @@ def test_random_loops_list_the_events_stepping_lists(body, loop, others, until_m
 def rig_events(fast_forward: bool, until_ms: int) -> dict:
     rig = read_rig(str(RASTER)).rig
     programs = {c.name: compile_file(c.program, target=c.model).program for c in rig.controllers}
-    result = simulate_rig(rig, programs, presses={"x": parse_buttons("1@0-100ms")},
-                          until_ms=until_ms, fast_forward=fast_forward)
+    result = simulate(rig, programs, presses={"x": parse_buttons("1@0-100ms")},
+                          until_ms=until_ms, fast_forward="all" if fast_forward else "off")
     return {name: run_json(r) for name, r in result.runs.items()}
 
 

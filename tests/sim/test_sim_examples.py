@@ -11,20 +11,21 @@ from mercmac.compiler import compile_file
 from mercmac.timespec import parse_buttons
 from mercmac.vm import events as ev
 from mercmac.sim import scenario
-from mercmac.sim.simulate import machine_for, simulate
+from mercmac.rig.open import open_program
+from mercmac.sim.simulate import Simulation, machine_for, simulate_program
 
 
 def example4(buttons: str, until_ms: int):
     compiled = compile_file(str(EXAMPLE4))
     assert not compiled.report.has_errors
-    return simulate(compiled.program, presses=parse_buttons(buttons), until_ms=until_ms)
+    return simulate_program(compiled.program, presses=parse_buttons(buttons), until_ms=until_ms)
 
 
 def test_example1_initialises_then_polls_for_ever():
     program = program_of("[MC00] EM5,EM13\n"
                          "[MC05] BF,DP200,DI,DD200,SV80000,SA400000,FE2,WS100,DH,SV250000\n"
                          "[MC13] EM14,EM15,EM16,EM17,WA20,RP,RP\n")
-    run = simulate(program, until_ms=3_600_000)
+    run = simulate_program(program, until_ms=3_600_000)
     m = run.machine
     assert m.running and m.macro == 13
     assert m.axis.sv == 250_000 and m.params["DP"] == 200 and m.params["DI"] == 0
@@ -37,7 +38,7 @@ def test_example1_fe2_finds_a_switch_away_from_zero():
                          "[MC05] BF,DP200,DI,DD200,SV80000,SA400000,FE2,WS100,DH,SV250000\n")
     from mercmac.vm import Options
 
-    run = simulate(program, until_ms=5000, options=Options(reference_at=12_000))
+    run = simulate_program(program, until_ms=5000, options=Options(reference_at=12_000))
     homes = [e for e in run.record.timeline if isinstance(e, ev.HomeDefined)]
     assert run.halted and len(homes) == 1 and homes[0].position == 0
     assert run.machine.position() == 0 and run.machine.axis.shift == -12_000
@@ -73,7 +74,7 @@ def test_example2_buttons_1_and_2_together():
 
 def test_example3_continuous_move_until_released_then_ab1():
     program = program_of("[MC00] EM17\n[MC17] XN1,MR-9999999,WF1,AB1\n")
-    run = simulate(program, presses=parse_buttons("1@0-1s"), until_ms=3000)
+    run = simulate_program(program, presses=parse_buttons("1@0-1s"), until_ms=3000)
     m = run.machine
     # after 1 s at up to 45000 c/s (reached after 112.5 ms) and AB1's 2531 counts of braking
     expected = -(45_000 * (1.0 - 0.001 - 45_000 / 400_000 / 2) + 45_000**2 / 800_000)
@@ -144,7 +145,7 @@ def test_example4_mode3_steps_while_held():
 def test_bundled_scenarios_pass(path):
     """examples/scenarios/NAME.anything.toml belongs to examples/macros/NAME.mcm."""
     name = os.path.basename(path).split(".")[0]
-    compiled = compile_file(str(EXAMPLES / (name + ".mcm")))
+    accepted = open_program(str(EXAMPLES / (name + ".mcm")))
     plan = scenario.load(path)
-    m, _ = machine_for(compiled.program)
-    assert scenario.run(m, plan, plan.until_ms or 10_000) == len(plan.expects) > 0
+    sim = Simulation(accepted.rig, {n: c.program for n, c in accepted.programs.items()})
+    assert scenario.run(sim, plan, plan.until_ms or 10_000) == len(plan.expects) > 0

@@ -23,7 +23,7 @@ from mercmac.sim import record as record_module
 from mercmac.cli import main
 from mercmac.render import progress as progress_module
 from mercmac.cli import run as sim_run
-from mercmac.sim.simulate import machine_for, simulate
+from mercmac.sim.simulate import machine_for, simulate_program
 
 DAY_MS = 86_400_000
 JOG = "autostart {\n  every 10ms { MR 1, WS 0 }\n}\n"  # MR1,WS0,WA10,RP,RP
@@ -184,7 +184,7 @@ BLINK_TP = "autostart {\n  every 20ms { CN 1, TP, WA 5, CF 1 }\n}\n"
 
 def test_ctrl_c_ends_the_run_where_it_is_and_keeps_what_came():
     hook = Interrupting(after=6)
-    run = simulate(program_of(BLINK_TP), until_ms=DAY_MS, progress=hook)
+    run = simulate_program(program_of(BLINK_TP), until_ms=DAY_MS, progress=hook)
     assert run.interrupted and hook.closed
     assert run.until_ms == hook.seen[-1] < DAY_MS
     assert run.record.reports and run.record.outputs
@@ -192,9 +192,9 @@ def test_ctrl_c_ends_the_run_where_it_is_and_keeps_what_came():
 
 def test_progress_slices_change_nothing_but_the_skips():
     program = program_of("autostart {\n  every 7ms { MR 3, WS 1, TP, CN 1, WA 2, CF 1 }\n}\n")
-    quiet = simulate(program, until_ms=40_000)
+    quiet = simulate_program(program, until_ms=40_000)
     hook = Interrupting(after=-1)
-    told = simulate(program, until_ms=40_000, progress=hook)
+    told = simulate_program(program, until_ms=40_000, progress=hook)
     assert not told.interrupted and hook.seen[-1] == 40_000
     assert len(hook.seen) > 3  # it was sliced
     for run in (quiet, told):

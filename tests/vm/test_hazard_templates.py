@@ -7,7 +7,7 @@ import string
 
 import pytest
 
-from mercmac.sim.simulate import simulate
+from mercmac.sim.simulate import simulate_program
 from mercmac.vm import hazards
 from mercmac.vm.hazards import HazardLog
 from mercmac.vm.models import Options
@@ -77,7 +77,7 @@ def test_the_log_words_a_hazard_the_first_time_only():
 
 
 def test_a_reported_hazard_is_its_template_filled_with_the_run_s_values():
-    run = simulate(program_of("[MC00] MR50000,WS0\n"), until_ms=5000,
+    run = simulate_program(program_of("[MC00] MR50000,WS0\n"), until_ms=5000,
                    options=Options(hard_limits=(-1000, 5000)))
     [hazard] = run.record.hazards
     assert hazard.message == RULES["hard-limit"].text(side="positive", position=5000)

@@ -10,7 +10,7 @@ import pytest
 
 from mercmac.emulator.faults import EmptySlot, Faults, Framing
 from mercmac.sim.record import Fold, Folded
-from mercmac.sim.simulate import simulate
+from mercmac.sim.simulate import simulate_program
 from mercmac.vm import Machine, Options
 from mercmac.vm import events as ev
 from mercmac.vm.motion import Ended, Side
@@ -83,7 +83,7 @@ def test_a_member_reads_prints_and_dumps_as_its_text(member):
 
 
 def test_timeline_folds_are_of_a_fold_kind():
-    run = simulate(program_of("[MC00] EM1,WA10,RP\n[MC01] XN1\n"), until_ms=200)
+    run = simulate_program(program_of("[MC00] EM1,WA10,RP\n[MC01] XN1\n"), until_ms=200)
     folds = [f for f in run.record.timeline if isinstance(f, Folded)]
     assert {f.kind for f in folds} >= {Fold.START, Fold.POLL}
     assert all(type(f.kind) is Fold for f in folds)

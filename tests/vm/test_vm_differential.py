@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from mercmac.compiler.program import Macro, Op, Program
-from mercmac.sim.simulate import simulate
+from mercmac.sim.simulate import simulate_program
 from mercmac.timespec import Press
 from helpers.budgets import budget
 from helpers.semantics import Firmware
@@ -39,7 +39,7 @@ def test_vm_agrees_with_the_reference_interpreter(macros, inputs):
     program = Program({s: Macro(s, f"MC{s:02d}", [Op(m, a) for m, a in ops])
                        for s, ops in macros.items()})
     presses = [Press(tuple(sorted(inputs)), 0, None)] if inputs else []
-    run = simulate(program, presses=presses, until_ms=BUDGET + 10)
+    run = simulate_program(program, presses=presses, until_ms=BUDGET + 10)
     assert [r.text for r in run.record.reports] == reference.reports
     assert [o.pattern for o in run.record.outputs] == reference.patterns
     assert run.halted

@@ -6,7 +6,8 @@ import inspect
 import io
 
 from mercmac.sim import plot, vcd
-from mercmac.sim.simulate import machine_for, simulate
+from mercmac.rig.model import Rig
+from mercmac.sim.simulate import machine_for, simulate, simulate_program
 from mercmac.vm import Machine
 from mercmac.vm import events as ev
 from helpers.compiling import program_of
@@ -62,7 +63,9 @@ def test_a_plot_and_a_vcd_hear_each_event_from_the_machine_not_from_each_other()
             self.heard.append(event)
 
     watch = Watch()
-    run = simulate(program_of(BLINK), until_ms=200, watch=watch, vcd=io.StringIO())
+    dump = vcd.Dump(io.StringIO(), ["program"])
+    run = simulate(Rig.of_program("program.mcm"), {"program": program_of(BLINK)}, until_ms=200,
+                   listeners={"program": [watch.on_event, *dump.listeners()["program"]]}).only
     assert watch.heard == run.record.events and run.record.events
     assert not hasattr(watch, "then")  # nobody chained the next listener to it
     for listener in (plot.PlotObserver, vcd.VcdObserver):

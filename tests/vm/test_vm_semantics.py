@@ -11,13 +11,13 @@ from mercmac.timespec import parse_buttons, parse_duration
 from mercmac.vm import Machine
 from mercmac.vm.events import MacroEntered
 from mercmac.sim.record import Folded
-from mercmac.sim.simulate import simulate
+from mercmac.sim.simulate import simulate_program
 
 
 def run(text: str, until: str = "10s", buttons: str = "", **kw):
     compiled = compile_source(Source("t.mcm", text))
     assert not compiled.report.has_errors, [d.message for d in compiled.report.items]
-    return simulate(compiled.program, presses=parse_buttons(buttons),
+    return simulate_program(compiled.program, presses=parse_buttons(buttons),
                     until_ms=parse_duration(until), **kw)
 
 

@@ -5,8 +5,9 @@ differs from it is reported as the rig rule model-mismatch (MR006) reports it, a
 the rig rules `check RIG` reports in a program (SC in macro 0, an input nothing drives),
 from the editor's text.
 
-The rig's checks are mercmac.rig.checks' (no second rig checker here); this module only
-finds the rig a document belongs to and picks what belongs to the document.
+A rig is opened as every command opens it (mercmac.rig.open: no second reader or checker
+here); this module only finds the rig a document belongs to and picks what belongs to the
+document.
 """
 from __future__ import annotations
 
@@ -16,9 +17,10 @@ from typing import Callable, NamedTuple
 from mercmac.compiler import Compilation, ast
 from mercmac.compiler.checking import Choice
 from mercmac.diagnostics import RULES, Diagnostic, Report
-from mercmac.rig.load import RigFile, is_rig_path, parse_rig, read_rig
+from mercmac.rig import is_rig_path
+from mercmac.rig.load import RigFile
 from mercmac.rig.model import Controller, Rig
-from mercmac.source import Source, Span, read_source, refuse_larger
+from mercmac.source import Source, Span, read_source
 
 # How many folders up from a program its rig may stand: a rig holds its programs in its
 # own folder or below (paths relative to the rig file), and a walk to the root of a deep
@@ -47,7 +49,7 @@ def rig_diagnostics(source: Source, choice: Choice) -> list[Diagnostic]:
     its path), under `choice`: its own findings, and those of a program that is the rig file
     (the programs' own belong to their files). Where `check` cannot read the rig (too large,
     a failure reading it or a program), one diagnostic at 1:1 says why: never a clean rig."""
-    from mercmac.rig.checks import check_rig
+    from mercmac.rig.open import RigUnreadable, open_rig
 
     here = os.path.realpath(source.name)
 
@@ -55,8 +57,9 @@ def rig_diagnostics(source: Source, choice: Choice) -> list[Diagnostic]:
         return source if os.path.realpath(path) == here else read_source(path)
 
     try:
-        refuse_larger(source.name, source.text)
-        found = check_rig(parse_rig(source), choice, read)
+        found = open_rig(source.name, text=source.text, read=read).checked(choice)
+    except RigUnreadable as e:  # `check`'s words for a file it cannot read
+        return [_unchecked(source, e)]
     except Exception as e:  # what stops `check` (or a bug) is said where the editor shows it
         return [_unchecked(source, e)]
     return [d for f in found if os.path.realpath(f.compilation.source.name) == here
@@ -66,11 +69,11 @@ def rig_diagnostics(source: Source, choice: Choice) -> list[Diagnostic]:
 def _unchecked(source: Source, e: Exception) -> Diagnostic:
     """Why the rig in `source` could not be checked, at 1:1: `check`'s words for a file it
     cannot read, else the error, as checking reports a compiler bug."""
-    from mercmac.outfile import reason
+    from mercmac.rig.open import RigUnreadable
 
     report = Report(source.name)
-    if isinstance(e, OSError):
-        report.add("rig-file", Span(1, 1), "unread", why=reason(e))
+    if isinstance(e, RigUnreadable):
+        report.add("rig-file", Span(1, 1), "unread", why=e.why)
     else:
         detail = f"{type(e).__name__}: {e}"
         report.add("rig-file", Span(1, 1), "internal",
@@ -114,23 +117,25 @@ def _rig_files(folder: str) -> list[str]:
 
 def _rig_file(path: str, text: str | None) -> RigFile | None:
     """The rig file at `path` (from `text` when open); None when it cannot be read."""
+    from mercmac.rig.open import RigUnreadable, open_rig
+
     try:
-        return read_rig(path) if text is None else parse_rig(Source(path, text))
-    except OSError:
+        return open_rig(path, text=text).rig_file
+    except RigUnreadable:
         return None
 
 
 def program_rig_diagnostics(owner: Owner, source: Source, choice: Choice) -> list[Diagnostic]:
     """What the rig rules of `check RIG` report in the program `source` (the editor's text
     of the owner's controller's program; the rig's other programs as saved)."""
-    from mercmac.rig.checks import check_rig
+    from mercmac.rig.open import Opened
 
     program = os.path.realpath(owner.controller.program)
 
     def read(path: str) -> Source:
         return source if os.path.realpath(path) == program else read_source(path)
 
-    _, *programs = check_rig(owner.rig_file, choice, read)
+    _, *programs = Opened(owner.rig_file, read=read).checked(choice)
     return [d for found in programs if found.compilation.source is source
             for d in found.diagnostics if d.rule.code in RIG_CODES]
 

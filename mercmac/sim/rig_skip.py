@@ -1,8 +1,9 @@
 """Fast-forward for a whole rig: skip the passes that the rig as a whole repeats.
 
 One machine's fast-forward (vm/optimiser.py) sees only its own state, and a machine that
-waits on a wired input cannot know when the other side will answer; so in a rig each
-machine runs instant by instant (sim/rig.py) and this module compares the joint state.
+waits on a wired input cannot know when the other side will answer; so in a rig the wired
+machines run instant by instant (sim/simulate.py) and this module compares their joint state
+(a controller no wire joins skips on its own).
 
 A joint anchor is an instant after which every axis rests on a whole-count target or moves
 on a profile it keys relative to the time and target, with no trigger pulse on
@@ -33,7 +34,7 @@ from mercmac.vm import events as ev
 from mercmac.vm import fastforward as ff
 
 if TYPE_CHECKING:
-    from mercmac.sim.rig import RigSim
+    from mercmac.sim.simulate import Simulation
 
 SEEN_LIMIT = 4096  # joint keys remembered; a rig whose state never repeats forgets them
 
@@ -56,9 +57,9 @@ class JointVisit:
 class JointForward:
     """Compares the rig at its joint anchors and skips repeating passes."""
 
-    def __init__(self, sim: RigSim):
+    def __init__(self, sim: Simulation):
         self.sim = sim
-        self.machines = list(sim.machines.values())
+        self.machines = list(sim.wired.machines.values())  # the ones no wire joins skip alone
         self.seen: dict[tuple, JointVisit] = {}
 
     def arrive(self, t: int, until: int) -> None:
