@@ -10,23 +10,11 @@ import subprocess
 
 import pytest
 
+from helpers.docs import HEADINGS
 from helpers.paths import ROOT
 
-# The pages of docs/ and their headings, as the docs name them. A new page or heading goes
-# here and into docs/ together.
-PAGES = {
-    "architecture": ("The floors", "One way down", "One table, one model, one renderer",
-                     "Where rigs live"),
-    "language": ("Programs and macros", "Statements", "Lowering", "Targets and settings"),
-    "checks": ("How check reads a file", "Rules", "Fixes"),
-    "simulator": ("Time", "Calls and the return point", "Repeat counters", "Conditions",
-                  "Motion", "Outputs and reports", "Power-on", "Fast-forward",
-                  "What sim writes"),
-    "uploader": ("The serial link", "Reading macros back", "A flash, step by step",
-                 "Backups and history", "Signals and lost ports"),
-    "rigs": ("The rig file", "Wires", "One instant", "Flashing and pulling a rig"),
-    "cli": ("Commands", "Exit codes", "JSON output", "Limits"),
-}
+# The pages of docs/ and their headings, by page name
+PAGES = {page.removesuffix(".md"): tuple(headings) for page, headings in HEADINGS.items()}
 
 # What a clone cannot follow: the contract's sections, the style file, the tracker.
 UNFOLLOWABLE = re.compile(r"SPEC §|STYLE\.md|\b[Ii]ssues? \d+")

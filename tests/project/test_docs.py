@@ -9,25 +9,12 @@ from pathlib import Path
 import pytest
 from markdown_it import MarkdownIt
 
+from helpers.docs import HEADINGS
 from helpers.paths import ROOT
 
 DOCS = ROOT / "docs"
 README = ROOT / "README.md"
 
-# page -> its `## ` headings, in order; code comments cite them as (docs/PAGE, "Heading")
-HEADINGS = {
-    "architecture.md": ["The floors", "One way down", "One table, one model, one renderer",
-                        "Where rigs live"],
-    "language.md": ["Programs and macros", "Statements", "Lowering", "Targets and settings"],
-    "checks.md": ["How check reads a file", "Rules", "Fixes"],
-    "simulator.md": ["Time", "Calls and the return point", "Repeat counters", "Conditions",
-                     "Motion", "Outputs and reports", "Power-on", "Fast-forward",
-                     "What sim writes"],
-    "uploader.md": ["The serial link", "Reading macros back", "A flash, step by step",
-                    "Backups and history", "Signals and lost ports"],
-    "rigs.md": ["The rig file", "Wires", "One instant", "Flashing and pulling a rig"],
-    "cli.md": ["Commands", "Exit codes", "JSON output", "Limits"],
-}
 PAGES = sorted(DOCS.glob("*.md"))
 DOCUMENTS = [README, *PAGES]
 _MD = MarkdownIt("commonmark")
