@@ -108,7 +108,7 @@ SLICE_S = 0.1  # wall time per slice of a run that reports progress
 
 def run_reporting(machine: Machine, until_ms: float, update) -> None:
     """Run to until_ms in slices of about SLICE_S of wall time, calling update(now_ms) after
-    each. The slices change what is skipped at once, not what happens (fastforward.py)."""
+    each. The slices change what is skipped at once, not what happens (vm/skips.py)."""
     step = 1.0
     while machine.now_ms < until_ms:
         began = time.perf_counter()
