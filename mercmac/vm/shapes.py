@@ -37,7 +37,6 @@ class Tag(Enum):
 
 
 REPORT, OUTPUTS = Tag.REPORT, Tag.OUTPUTS  # what count and expand select
-MOVE = Tag.MOVE  # the tag of a Move laid out as a plain tuple (_same_arrival reads either)
 
 
 class Report(NamedTuple):

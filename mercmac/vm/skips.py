@@ -278,8 +278,8 @@ def _unclamped(move: Move, pos: int, delta: int, fit: int) -> int:
     """Passes whose move targets stay unclamped (a clamp is a soft-limit boundary)."""
     if move.requested is None or delta == 0:  # a stop, or the very same targets every pass
         return fit
-    relative, lo, hi = move.requested
-    return _last_inside(lo, hi, pos + relative, delta, fit)
+    requested = move.requested
+    return _last_inside(requested.lo, requested.hi, pos + requested.target, delta, fit)
 
 
 def _clear(move: Move, pos: int, delta: int, fit: int, hard: tuple | None) -> int:
@@ -296,7 +296,7 @@ def _clear(move: Move, pos: int, delta: int, fit: int, hard: tuple | None) -> in
 def _same_arrival(move: Move, wake: int, period: int, fit: int) -> int:
     """Passes in which the profile's end, summed in floats from its start time, still rounds
     up to the same microsecond: each of the sums adds at most half an ulp of the time."""
-    offset, arrival, dts = move[1], move[6], move[7]  # any tuple laid out as a Move
+    offset, arrival, dts = move.offset, move.arrival, move.dts
     if not dts:
         return fit
     if arrival == sum(dts) and all(float(d).is_integer() for d in dts):
