@@ -20,7 +20,7 @@ from mercmac.render import jsontext
 from mercmac.render.console import Line, write_lines
 from mercmac.timespec import format_clock, format_span
 from mercmac.vm import events as ev
-from mercmac.vm import fastforward as ff
+from mercmac.vm import shapes
 from mercmac.vm.motion import Ended
 from mercmac.sim import record
 from mercmac.sim.record import Fold, Folded, Recorder
@@ -104,7 +104,7 @@ def _move(t: int, kind: ev.Motion, target: int, arrival: float, segments: tuple)
 
 def _emitted(shape: tuple) -> str:
     """', 1 report, 2 LED changes': what each skipped pass emitted (counted in the summary)."""
-    reports, changes = ff.count(shape, ff.REPORT), ff.count(shape, ff.OUTPUTS)
+    reports, changes = shapes.count(shape, shapes.REPORT), shapes.count(shape, shapes.OUTPUTS)
     parts = ([plural(reports, "report")] if reports else []) + \
         ([plural(changes, "LED change")] if changes else [])
     return "".join(f", {part}" for part in parts)

@@ -25,7 +25,7 @@ from mercmac.errors import InputError
 from mercmac.outfile import replacing, writable_target
 from mercmac.timespec import format_clock, format_span
 from mercmac.vm import events as ev
-from mercmac.vm import fastforward as ff
+from mercmac.vm import shapes
 
 FORMATS = (".png", ".svg", ".pdf", ".html")
 MISSING = "needs the plot extra: pip install 'mercmac[plot]'"
@@ -150,19 +150,19 @@ class PlotObserver:
             case ev.FastForwarded(_, t_to, passes, _, loop, shape):
                 self.trace.skips.append((t, t_to, passes, loop.label))
                 self._skipped_outputs(event)
-                if not ff.plain(shape) or event.shift:
+                if not shapes.plain(shape) or event.shift:
                     self._moved(event)
 
     def _skipped_outputs(self, skip: ev.FastForwarded) -> None:
         """The output changes of skipped passes, each where a few (a rig's wire lanes show
         every handshake); of many, the pattern the last pass leaves (a hatched band)."""
-        if ff.count(skip.shape, ff.OUTPUTS) * skip.passes > SKIP_OUTPUTS:
+        if shapes.count(skip.shape, shapes.OUTPUTS) * skip.passes > SKIP_OUTPUTS:
             last = _last_pattern(skip.shape)
             if last is not None:
                 self._pattern(last, skip.t_to)
             return
-        for change in ff.expand(skip.shape, skip.t, skip.period, skip.passes, ff.OUTPUTS,
-                                skip.position, skip.shift):
+        for change in shapes.expand(skip.shape, skip.t, skip.period, skip.passes, shapes.OUTPUTS,
+                                    skip.position, skip.shift):
             self._pattern(change.pattern, change.t)
 
     def _moved(self, skip: ev.FastForwarded) -> None:
@@ -181,7 +181,7 @@ class PlotObserver:
 
     def _copied(self, skip: ev.FastForwarded) -> bool:
         """The positions and targets of skipped passes drawn as those of the pass before
-        them, each `shift` further (the passes are copies: vm/fastforward.py); False
+        them, each `shift` further (the passes are copies: vm/skips.py); False
         when that pass has no samples or the copies would be more than COPIED."""
         before = skip.t - skip.period
         last = _since(self.trace.position, before, skip.t)
@@ -271,7 +271,7 @@ def _time(sample: tuple) -> float:
 def _last_pattern(shape: tuple) -> int | None:
     """The output pattern a skipped pass leaves behind, if it changes any."""
     last = None
-    for step in ff.compact(shape, 0, 0, 1):  # one pass: only the patterns matter here
+    for step in shapes.compact(shape, 0, 0, 1):  # one pass: only the patterns matter here
         match step:
             case ev.OutputsChanged(_, pattern):
                 last = pattern

@@ -24,7 +24,7 @@ from typing import Iterator
 
 from mercmac.ops import TextEnum
 from mercmac.vm import events as ev
-from mercmac.vm import fastforward as ff
+from mercmac.vm import shapes
 from mercmac.vm.opcodes import Opcode
 
 # Reports, output changes and events beyond this are counted, not listed
@@ -84,7 +84,7 @@ def _size(entry) -> int:
 
 def _moved(event, dt: int, dx: int, texts):
     """An event of a stepped pass as the pass `dt` us and `dx` counts later makes it; a
-    report's text comes from the skip's own reports (fastforward.expand) when it shifts.
+    report's text comes from the skip's own reports (shapes.expand) when it shifts.
     (Built by the constructors: dataclasses.replace is four times slower, and a skip may list
     10,000 of them.)"""
     cls = type(event)
@@ -195,14 +195,14 @@ class Recorder:
 
     def _skipped(self, skip: ev.FastForwarded) -> None:
         """What skipped passes emitted: listed up to the cap, counted."""
-        for kind, into, what in ((ff.REPORT, self.reports, "reports"),
-                                 (ff.OUTPUTS, self.outputs, "outputs")):
-            total = ff.count(skip.shape, kind) * skip.passes
+        for kind, into, what in ((shapes.REPORT, self.reports, "reports"),
+                                 (shapes.OUTPUTS, self.outputs, "outputs")):
+            total = shapes.count(skip.shape, kind) * skip.passes
             if total:
                 listed = len(into)
                 room = max(CAP - listed, 0)
-                into.extend(islice(ff.expand(skip.shape, skip.t, skip.period, skip.passes, kind,
-                                            skip.position, skip.shift),
+                into.extend(islice(shapes.expand(skip.shape, skip.t, skip.period, skip.passes, kind,
+                                                skip.position, skip.shift),
                                    room))
                 self.dropped[what] += total - (len(into) - listed)
         self._skipped_events(skip)
@@ -223,9 +223,9 @@ class Recorder:
         if not block.size:
             return
         texts = None
-        if skip.shift or not ff.plain(skip.shape):  # positions in reports move on
-            texts = ff.expand(skip.shape, skip.t, skip.period, skip.passes, ff.REPORT,
-                              skip.position, skip.shift)
+        if skip.shift or not shapes.plain(skip.shape):  # positions in reports move on
+            texts = shapes.expand(skip.shape, skip.t, skip.period, skip.passes, shapes.REPORT,
+                                  skip.position, skip.shift)
         listed = len(self.events)
         self.events.extend(islice(unroll(block.template, skip.passes, skip.period,
                                          skip.shift, 0, 0, texts), max(CAP - listed, 0)))

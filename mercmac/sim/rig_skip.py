@@ -15,11 +15,11 @@ Optimiser.effects, ...); this module keeps what is about several controllers
 (docs/simulator.md, "Fast-forward"). When the key comes back,
 the rig passed through a pass; when two passes in a row have the same shape (per machine:
 moves, arrivals, reports, output changes relative to the pass's start time and position,
-fastforward.moved_shape) and the same shifts, the next passes are copies, each `period`
+shapes.moved_shape) and the same shifts, the next passes are copies, each `period`
 later and `delta` further on per axis, until a button or joystick change, the end of the
 run, or a boundary of a shifted move (a soft limit, a switch, an arrival that could round
 to another microsecond, a power of two of positions or time for a pass that computes with
-fractions: fastforward.shifted_passes) — the rules of the single machine, applied to all at
+fractions: skips.shifted_passes) — the rules of the single machine, applied to all at
 once. What a pass does that cannot shift exactly (a hazard, a search, a limit hit) makes
 its shape None, and the rig steps it.
 """
@@ -31,7 +31,8 @@ from typing import TYPE_CHECKING
 
 from mercmac.sim.record import CAP
 from mercmac.vm import events as ev
-from mercmac.vm import fastforward as ff
+from mercmac.vm.shapes import moved_shape, plain
+from mercmac.vm.skips import Pass
 
 if TYPE_CHECKING:
     from mercmac.sim.simulate import Simulation
@@ -113,7 +114,7 @@ class JointForward:
         return min(t, self.sim.holds[0][0]) if self.sim.holds else t
 
     def _shapes(self, previous: JointVisit, visit: JointVisit) -> tuple | None:
-        """Each machine's pass from `previous` to `visit`, as fastforward.moved_shape sees it
+        """Each machine's pass from `previous` to `visit`, as shapes.moved_shape sees it
         (the wires' input changes are left out: the joint key holds the lines)."""
         shapes = []
         for i, m in enumerate(self.machines):
@@ -121,7 +122,7 @@ class JointForward:
             if effects is None:
                 return None  # the log was cut since: the pass is not known whole
             events = [e for e in effects if type(e) is not ev.InputChanged]
-            shape = ff.moved_shape(events, previous.t, previous.positions[i])
+            shape = moved_shape(events, previous.t, previous.positions[i])
             if shape is None:
                 return None
             shapes.append(shape)
@@ -134,8 +135,8 @@ class JointForward:
             if fit <= 0:
                 break
             shape = visit.shapes[i]
-            if not ff.plain(shape):
-                now = ff.Pass(visit.t, visit.positions[i], visit.deltas[i], shape)
+            if not plain(shape):
+                now = Pass(visit.t, visit.positions[i], visit.deltas[i], shape)
                 fit = m.optimiser.shifted_passes(now, period, fit)
         return fit
 

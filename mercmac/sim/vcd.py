@@ -19,7 +19,7 @@ from typing import IO
 from vcd import VCDWriter
 
 from mercmac.vm import events as ev
-from mercmac.vm import fastforward as ff
+from mercmac.vm import shapes
 
 SAMPLE_US = 1000  # position samples while moving
 MOVES_KEPT = 64  # moves remembered for the last pass of a shifted skip (a longer pass: some)
@@ -112,15 +112,15 @@ class VcdObserver:
         """Skipped passes: marked, all but the last left out; the last one dumped (of a
         shifted skip with the position: vcd changes must come in time order)."""
         changes = []
-        for step in ff.compact(skip.shape, skip.t, skip.period, skip.passes):
+        for step in shapes.compact(skip.shape, skip.t, skip.period, skip.passes):
             match step:
-                case ff.Stretch(start, last, n):
+                case shapes.Stretch(start, last, n):
                     if n > 1:
                         changes += [(start, self.skipping, 1), (last, self.skipping, 0)]
                 case ev.OutputsChanged(at, pattern):
                     changes += [(at, var, pattern >> i & 1)
                                 for i, var in enumerate(self.outputs)]
-        moves = skip.shift or not ff.plain(skip.shape)
+        moves = skip.shift or not shapes.plain(skip.shape)
         if moves:
             changes += self._last_pass(skip)
         for t, var, value in sorted(changes, key=lambda change: change[0]):

@@ -145,7 +145,7 @@ class FastForwarded:
     """`passes` identical passes of a loop skipped from t to t_to, `period` us each.
 
     `shape` is what each skipped pass emitted (reports, output changes, inner
-    skips: fastforward's items) relative to its start; fastforward.count and expand read it.
+    skips: the items of vm/shapes.py) relative to its start; shapes.count and expand read it.
     """
 
     t: int
@@ -154,7 +154,7 @@ class FastForwarded:
     period: int
     loop: Where
     shape: tuple = ()
-    position: int = 0  # a shifted skip (fastforward.moved_shape): the first pass's start position
+    position: int = 0  # a shifted skip (shapes.moved_shape): the first pass's start position
     shift: int = 0  # and how much further each next pass starts; 0: passes identical
     # when the loop came round: the skipped passes end there, k periods on (t, the next
     # command, may be a cycle later, and an arrival fall between); None: at t

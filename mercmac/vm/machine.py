@@ -21,18 +21,18 @@ from mercmac.compiler.program import Program
 from mercmac.mdtext import slot_name
 from mercmac.ops import Op
 from mercmac.vm import events as ev
-from mercmac.vm import fastforward as ff
 from mercmac.vm import reports
+from mercmac.vm import shapes
 from mercmac.vm.assemble import DIRECT, Chunk, assemble, assemble_ops
 from mercmac.vm.clock import Clock
 from mercmac.vm.disasm import instruction
-from mercmac.vm.fastforward import Anchor
 from mercmac.vm.hazards import HazardLog
 from mercmac.vm.lines import Inputs, Outputs
 from mercmac.vm.models import DEFAULTS, Options, model_name
 from mercmac.vm.motion import Axis, Ended
 from mercmac.vm.opcodes import Opcode
 from mercmac.vm.optimiser import Anchors, FastForward, Jump, Optimiser
+from mercmac.vm.skips import Anchor
 from mercmac.vm.statekey import items, key, keyed, part, sorted_items, unkeyed
 from mercmac.vm.trigger import PULSE_US, Trigger
 
@@ -783,8 +783,8 @@ class Machine:
             self.counters[self.chunk.slot][jump.own] -= jump.passes
         self._move_on(jump.passes * jump.period, jump.passes * jump.shift)
         if self.on_report is not None:  # the host hears every report (mercmac emulate)
-            for r in ff.expand(jump.shape, start, jump.period, jump.passes, ff.REPORT,
-                               jump.position, jump.shift):
+            for r in shapes.expand(jump.shape, start, jump.period, jump.passes, shapes.REPORT,
+                                   jump.position, jump.shift):
                 self.on_report(r.t / 1000, r.text)
         self._emit(ev.FastForwarded(start, self.wake, jump.passes, jump.period,
                                     self._where_anchor(jump.anchor), jump.shape,

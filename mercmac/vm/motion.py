@@ -155,7 +155,7 @@ class Axis:
         """Move the axis on by `dt` us and `dx` counts: where the passes a fast-forward skips
         leave it (vm/optimiser.py). A profile planned from rest on a count is planned again
         from there, as stepping plans it; any other is moved on, the same floats within one
-        power of two (fastforward._same_binade bounds such skips)."""
+        power of two (skips._same_binade bounds such skips)."""
         self.target += dx
         self.final += dx
         p = self.plan

@@ -1,5 +1,5 @@
 """The fast-forward optimiser of one machine: its loops' last visits, its effect log and the
-horizon of its run (the rules of when passes repeat are in vm/fastforward.py).
+horizon of its run (the rules of when passes repeat are in vm/skips.py).
 
 The machine runs every instruction itself and tells its optimiser what matters through a
 few named hooks: a macro was entered, a loop came round or ran out, a wait began, an
@@ -16,8 +16,9 @@ from typing import TYPE_CHECKING, NamedTuple
 from mercmac.commands import COMMANDS, Mnemonic
 from mercmac.ops import TextEnum
 from mercmac.vm import events as ev
-from mercmac.vm import fastforward as ff
-from mercmac.vm.fastforward import Anchor, Loop, Note, Visit
+from mercmac.vm import shapes, skips
+from mercmac.vm.shapes import Note
+from mercmac.vm.skips import Anchor, Loop, Visit
 
 if TYPE_CHECKING:
     from mercmac.vm.machine import Machine
@@ -51,7 +52,7 @@ class Jump(NamedTuple):
     own: int | None  # the jumping RP's place, whose counter counts the passes
     passes: int
     period: int
-    shape: tuple  # what each pass emitted (fastforward.shape or moved_shape)
+    shape: tuple  # what each pass emitted (shapes.shape or moved_shape)
     position: int  # where the first pass starts (a shifted jump)
     shift: int
     counted: tuple[int, int]  # events of each pass: (others, macro entries and exits)
@@ -76,9 +77,9 @@ class Optimiser:
         self.machine = machine
         self.mode = mode
         # what it must know of a pass: what it emitted, or only whether it emitted anything
-        self.shape = ff.shape if mode is FastForward.ALL else ff.silent
+        self.shape = shapes.shape if mode is FastForward.ALL else shapes.silent
         self.anchors = Anchors()
-        self.log: list = []  # effects since log_base: what passes emitted (fastforward.shape)
+        self.log: list = []  # effects since log_base: what passes emitted (shapes.shape)
         self.log_base = 0
         self.horizon = INF  # the end of the run: it bounds a jump (skippable)
         self.waits = 0  # wait commands executed (a loop without any is a busy loop)
@@ -125,7 +126,7 @@ class Optimiser:
 
     def move_requested(self, target: int) -> None:
         """A move asked for `target`, clamped to the soft range it was asked in."""
-        self.log.append(ff.Requested(target, *self.machine.axis.soft_range()))
+        self.log.append(shapes.Requested(target, *self.machine.axis.soft_range()))
 
     def profile_starting(self) -> None:
         """A profile starts: from rest on a count it shifts exactly in any pass; from a moving
@@ -140,7 +141,7 @@ class Optimiser:
             self.log.append(Note.FLOATS)
 
     def reported(self, mnemonic: str) -> None:
-        """Note how the report just made depends on the position (fastforward.moved_shape):
+        """Note how the report just made depends on the position (shapes.moved_shape):
         TT shows the target; at rest on a count TP and TD show it, TS the switches; while
         moving, TP, TD and TE round a float position, TV shows a velocity and TS the
         switches and the motion, all the same a pass later within one power of two."""
@@ -148,7 +149,7 @@ class Optimiser:
             return
         axis = self.machine.axis
         if mnemonic == Mnemonic.TT:
-            self.log.append(ff.Shows(COMMANDS[mnemonic].report, axis.target))
+            self.log.append(shapes.Shows(COMMANDS[mnemonic].report, axis.target))
             return
         if not axis.at_rest_on_count():
             now = self.machine.clock.now
@@ -158,14 +159,14 @@ class Optimiser:
                 self.log.append(Note.UNSHIFTABLE)
                 return
             if mnemonic in (Mnemonic.TP, Mnemonic.TD):  # (a Shows follows its report)
-                self.log.append(ff.Shows(COMMANDS[mnemonic].report, round(x)))
+                self.log.append(shapes.Shows(COMMANDS[mnemonic].report, round(x)))
             elif mnemonic == Mnemonic.TS:
                 self.log.append(Note.SWITCHES)
             self.log.append(Note.FLOATS)
         elif mnemonic == Mnemonic.TS:
             self.log.append(Note.SWITCHES)
         elif mnemonic in (Mnemonic.TP, Mnemonic.TD):
-            self.log.append(ff.Shows(COMMANDS[mnemonic].report, int(axis.final)))
+            self.log.append(shapes.Shows(COMMANDS[mnemonic].report, int(axis.final)))
 
     def trigger_set(self) -> None:
         """ZM, ZP or ZI in a pass: it arms the trigger at ZP, a position that does not move
@@ -223,7 +224,7 @@ class Optimiser:
 
     # ------------------------------------------------------------ at a loop anchor
     def _arrive(self, anchor: Anchor, own: int | None, remaining: float) -> None:
-        """A loop came round: report a busy loop, skip identical passes (fastforward.py)."""
+        """A loop came round: report a busy loop, skip identical passes (vm/skips.py)."""
         previous = self.anchors.visits.get(anchor)
         fresh = self._fresh(previous)
         key = self._key(own, previous, fresh)
@@ -233,13 +234,13 @@ class Optimiser:
         self.anchors.visits[anchor] = visit
         if previous is None or self.mode is FastForward.OFF:
             return
-        if not ff.same_pass(previous, visit):
-            if self.mode is FastForward.ALL and ff.same_shifted_pass(previous, visit):
+        if not skips.same_pass(previous, visit):
+            if self.mode is FastForward.ALL and skips.same_shifted_pass(previous, visit):
                 self._skip_shifted(anchor, own, previous, visit, remaining)
             return
         if visit.shape and self.mode is not FastForward.ALL:
             return
-        passes = ff.skippable(previous, visit, self._bound(), remaining)
+        passes = skips.skippable(previous, visit, self._bound(), remaining)
         if passes > 0:
             self._jump(Jump(anchor, own, passes, visit.wake - previous.wake, visit.shape,
                             visit.position, 0, self._counted(previous, visit)), visit)
@@ -250,7 +251,7 @@ class Optimiser:
         period = visit.wake - previous.wake
         # the running profile's arrival is the pass's own (its shape has it; its limit hit is a
         # boundary, shifted_passes): only other hardware events bound the skip
-        fit = ff.skippable(previous, visit, self._bound(axis=False), remaining)
+        fit = skips.skippable(previous, visit, self._bound(axis=False), remaining)
         passes = self.shifted_passes(visit, period, fit)
         if passes < fit:  # a boundary, not the counter, ends it: enclosing passes differ
             self.log.append(Note.UNSHIFTABLE)
@@ -258,13 +259,13 @@ class Optimiser:
             self._jump(Jump(anchor, own, passes, period, visit.moved, visit.position,
                             visit.delta, self._counted(previous, visit)), visit)
 
-    def shifted_passes(self, now: ff.Pass | Visit, period: int, fit: int) -> int:
+    def shifted_passes(self, now: skips.Pass | Visit, period: int, fit: int) -> int:
         """How many of `fit` passes, each `period` us and `now.delta` counts on from the one
-        that ended at `now`, stay clear of this machine's boundaries (ff.shifted_passes)."""
-        return ff.shifted_passes(now, period, fit, *self.boundaries())
+        that ended at `now`, stay clear of this machine's boundaries (skips.shifted_passes)."""
+        return skips.shifted_passes(now, period, fit, *self.boundaries())
 
     def boundaries(self) -> tuple:
-        """What bounds a shifted skip here (fastforward.shifted_passes): the soft range, the
+        """What bounds a shifted skip here (skips.shifted_passes): the soft range, the
         limit switches, the reference edge in present coordinates, a grid trigger's ZI."""
         axis, trigger = self.machine.axis, self.machine.trigger
         grid = abs(trigger.increment) if trigger.mode == 3 else 0
@@ -292,7 +293,7 @@ class Optimiser:
         for e in self.log[previous.logged - self.log_base:visit.logged - self.log_base]:
             if type(e) is ev.FastForwarded:
                 effects += e.passes * e.events[0] if e.events else 0
-            elif not isinstance(e, ff.NOTES):
+            elif not isinstance(e, shapes.NOTES):
                 effects += 1
         return effects, visit.flows - previous.flows
 
@@ -323,7 +324,7 @@ class Optimiser:
         if (whole and pass_shape is None and skey is not None and skey == previous.skey
                 and self.mode is FastForward.ALL):
             delta = position - previous.position
-            moved = ff.moved_shape(self.log[previous.logged - self.log_base:],
+            moved = shapes.moved_shape(self.log[previous.logged - self.log_base:],
                                    previous.wake, previous.position)
         return Visit(key, self.machine.wake, self.inputs, self.waits,
                      self.logged(), pass_shape, skey, position, delta, moved,

@@ -22,7 +22,7 @@ def key(as_: Callable | None = None, *, own: bool = False, shifts: bool = False,
         **options) -> Field:
     """A keyed field: its value, or `as_(value)` (a dict as its items, a chunk as its slot);
     with `own`, `as_(part, own)` (all RP counters but the jumping RP's own). `shifts`: a
-    shifted pass (fastforward.py) may differ in it by whole counts."""
+    shifted pass (vm/skips.py) may differ in it by whole counts."""
     return field(metadata={_KEY: True, _AS: as_, _OWN: own, _SHIFTS: shifts}, **options)
 
 

@@ -1,7 +1,7 @@
 """Fast-forward of passes that move on the way: a profile still running when the
 loop comes round, moves started while the axis moves, and reports (TP, TD, TE, TV, TS) taken
 during a move. Such passes repeat shifted, bit for bit, while their positions and times stay
-within one power of two (fastforward._same_binade); the skips must give exactly what plain
+within one power of two (skips._same_binade); the skips must give exactly what plain
 stepping gives: reports, outputs, hazards, every event but the skip markers, and the state.
 Trigger pulses (ZM) in such passes repeat too, where the trigger stands alike relative to the
 target (Trigger.relative)."""
@@ -21,8 +21,9 @@ from mercmac.compiler.program import Macro, Op, Program
 from mercmac.sim import record as record_module
 from mercmac.sim.simulate import machine_for
 from mercmac.vm import events as ev
-from mercmac.vm import fastforward as ff
+from mercmac.vm import shapes
 from mercmac.vm.models import Options
+from mercmac.vm.skips import _within_binade
 
 # the loops (i) and (j) of benchmarks/sim_speed.py: reports between short moves, and a long
 # body moving on the way
@@ -114,8 +115,8 @@ GRID = "[MC00] ZM3,ZI7,MA-500,WS0,EM1\n[MC01] MR28,WS0,WA2,TP,RP,RP\n"
 def test_trigger_pulses_of_a_scan_are_skipped_exactly(source, model):
     skips = same_as_stepping(program_of(source), [5, 900, 20_000], model)
     assert sum(s.passes for s in skips if s.shift) > 300
-    shapes = [s.shape for s in skips if s.shift]
-    assert any(ff.count(shape, ff.OUTPUTS) >= 4 for shape in shapes)  # two pulses, on and off
+    # two pulses, on and off
+    assert any(shapes.count(s.shape, shapes.OUTPUTS) >= 4 for s in skips if s.shift)
 
 
 def test_a_scan_whose_shift_is_off_the_grid_is_stepped_as_it_must_be():
@@ -129,11 +130,11 @@ def test_a_skip_stops_where_a_power_of_two_is_crossed():
     # passes on the way compute with fractional positions, whose floats round otherwise in
     # another power of two: a pass spanning 60..62 moves on one count, to 61..63, and stops
     # before 62..64 reaches [64, 128)
-    assert ff._within_binade(60, 62, 1, 100) == 1
-    assert ff._within_binade(64, 70, 1, 100) == 57  # up to 121..127
-    assert ff._within_binade(-70, -64, -1, 100) == 57  # the same below zero
-    assert ff._within_binade(-3, 5, 1, 100) == 0  # across zero
-    assert ff._within_binade(2**36, 2**36 + 10, 10**6, 10**9) == (2**36 - 11) // 10**6
+    assert _within_binade(60, 62, 1, 100) == 1
+    assert _within_binade(64, 70, 1, 100) == 57  # up to 121..127
+    assert _within_binade(-70, -64, -1, 100) == 57  # the same below zero
+    assert _within_binade(-3, 5, 1, 100) == 0  # across zero
+    assert _within_binade(2**36, 2**36 + 10, 10**6, 10**9) == (2**36 - 11) // 10**6
 
 
 # -- the property: skipping passes that move on the way changes nothing but the speed -----

@@ -17,7 +17,9 @@ from helpers.compiling import program_of
 from helpers.simulation import skips, states
 from mercmac.compiler.program import Macro, Op, Program
 from mercmac.timespec import Press
-from mercmac.vm import fastforward as ff
+from mercmac.vm.events import Motion
+from mercmac.vm.shapes import Move, Tag
+from mercmac.vm.skips import _same_arrival
 from mercmac.vm.models import Options
 from mercmac.sim import record as record_module
 from mercmac.cli import main
@@ -81,19 +83,25 @@ def test_a_button_release_is_a_boundary():
     assert fast == plain and skips(record)
 
 
+def move_of(arrival: float, dts: tuple[float, ...]) -> Move:
+    """A move one count on from the pass's start, arriving `arrival` us after its start in
+    segments of `dts` us."""
+    return Move(Tag.MOVE, 0, Motion.MOVE, 1, 0, None, arrival, dts, 0, 1)
+
+
 def test_an_arrival_that_floats_could_round_otherwise_is_not_skipped_that_far():
     # segments of whole microseconds from a command's whole time: every float sum is exact
     # below 2**53 us, and no further
-    item = (ff.MOVE, 0, "move", 1, 0, None, 3, (1.0, 2.0))
-    assert ff._same_arrival(item, 0, 10, 100) == 100
-    assert ff._same_arrival(item, 2**53 - 1000, 10, 10**6) < 100
+    item = move_of(3, (1.0, 2.0))
+    assert _same_arrival(item, 0, 10, 100) == 100
+    assert _same_arrival(item, 2**53 - 1000, 10, 10**6) < 100
     # a hair over a whole number of us (the C-663's 2000.0000000000002 twice): the sum rounds
     # either way with the time, so no time is safe by this rule (_same_time_binade's is)
-    item = (ff.MOVE, 0, "move", 1, 0, None, 4000, (2000.0000000000002, 2000.0000000000002))
-    assert ff._same_arrival(item, 0, 10, 100) == 0
+    item = move_of(4000, (2000.0000000000002, 2000.0000000000002))
+    assert _same_arrival(item, 0, 10, 100) == 0
     # 0.25 us from the next microsecond: safe while an ulp of the time is far smaller
-    item = (ff.MOVE, 0, "move", 1, 0, None, 4, (1.5, 2.25))
-    safe = ff._same_arrival(item, 0, 2**30, 10**9)
+    item = move_of(4, (1.5, 2.25))
+    safe = _same_arrival(item, 0, 2**30, 10**9)
     assert 0 < safe < 10**9
     latest = (safe + 1) * 2**30 + 5
     assert math.ulp(float(latest)) * 2 >= 0.25 or safe == 10**9

@@ -1,5 +1,5 @@
 """The interpreter and its fast-forward optimiser are two things; the
-state key comes from field marks; shapes are typed records walked by fastforward; the
+state key comes from field marks; shapes are typed records walked by vm/shapes.py; the
 modes, the wait, the return point and a hazard's place are types."""
 from __future__ import annotations
 
@@ -12,15 +12,15 @@ from helpers.compiling import program_of
 from helpers.paths import PACKAGE
 from mercmac.vm import Machine
 from mercmac.vm import events as ev
-from mercmac.vm import fastforward as ff
+from mercmac.vm import shapes
 from mercmac.vm.machine import Blocked, Return, Wait
 from mercmac.vm.motion import Axis
 from mercmac.vm.trigger import Trigger
 from mercmac.vm.optimiser import FastForward, Optimiser
 from mercmac.vm.statekey import key, keyed, part, unkeyed
 
-ITEMS = (ff.Report, ff.Outputs, ff.Skip, ff.Shifted, ff.Placed, ff.Absolute, ff.Move,
-         ff.Arrive)
+ITEMS = (shapes.Report, shapes.Outputs, shapes.Skip, shapes.Shifted, shapes.Placed,
+         shapes.Absolute, shapes.Move, shapes.Arrive)
 # every 50ms a report and 20 blinks; scans of 50 steps, each showing its position and
 # blinking; a step there and back that shows the target and the switches
 LOOPS = ("autostart {\n  every 50ms { TT, repeat 20 { CN 1, WA 1, CF 1 } }\n}\n",
@@ -114,12 +114,12 @@ def test_the_machines_shift_key_leaves_out_positions_targets_and_profiles_only()
     assert shifted == tuple(expected)
 
 
-# -- shapes are typed records, walked by fastforward ---------------------------------------
+# -- shapes are typed records, walked by vm/shapes.py --------------------------------------
 
 def flatten(shape: tuple):
     for item in shape:
         yield item
-        if isinstance(item, (ff.Skip, ff.Shifted)):
+        if isinstance(item, (shapes.Skip, shapes.Shifted)):
             yield from flatten(item.shape)
 
 
@@ -130,16 +130,16 @@ def test_every_shape_item_is_a_named_record_with_its_tag():
 
 
 def test_items_of_two_kinds_never_compare_equal():
-    assert ff.Outputs(ff.Tag.OUTPUTS, 5, 3) != ff.Arrive(ff.Tag.ARRIVE, 5, 3)
+    assert shapes.Outputs(shapes.Tag.OUTPUTS, 5, 3) != shapes.Arrive(shapes.Tag.ARRIVE, 5, 3)
 
 
 def test_compact_gives_the_stretches_and_the_last_passes_output_changes():
-    blink = (ff.Outputs(ff.Tag.OUTPUTS, 0, 1), ff.Outputs(ff.Tag.OUTPUTS, 5, 0))
-    shape = (ff.Skip(ff.Tag.SKIP, 10, 3, 20, blink, None),)
-    assert list(ff.compact(shape, 1000, 100, 4)) == [
-        ff.Stretch(1000, 1300, 4), ff.Stretch(1310, 1350, 3),
+    blink = (shapes.Outputs(shapes.Tag.OUTPUTS, 0, 1), shapes.Outputs(shapes.Tag.OUTPUTS, 5, 0))
+    shape = (shapes.Skip(shapes.Tag.SKIP, 10, 3, 20, blink, None),)
+    assert list(shapes.compact(shape, 1000, 100, 4)) == [
+        shapes.Stretch(1000, 1300, 4), shapes.Stretch(1310, 1350, 3),
         ev.OutputsChanged(1350, 1), ev.OutputsChanged(1355, 0)]
-    assert [e.t for e in ff.expand(shape, 1000, 100, 2, ff.OUTPUTS)] == [
+    assert [e.t for e in shapes.expand(shape, 1000, 100, 2, shapes.OUTPUTS)] == [
         1010, 1015, 1030, 1035, 1050, 1055, 1110, 1115, 1130, 1135, 1150, 1155]
 
 

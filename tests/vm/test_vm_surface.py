@@ -17,7 +17,7 @@ from mercmac.upload import flasher
 from mercmac.upload.errors import Refused
 from mercmac.vm import Machine, Options
 from mercmac.vm import reports
-from mercmac.vm.fastforward import Anchor, Loop
+from mercmac.vm.skips import Anchor, Loop
 from mercmac.vm.machine import Wait
 from mercmac.vm.models import DEFAULTS
 from helpers.emulator import FAST_TIMING, serve
