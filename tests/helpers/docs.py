@@ -1,6 +1,6 @@
 """The pages of docs/ and their `## ` headings, in order, as the docs name them: code comments
-cite them as (docs/PAGE.md, "Heading"). A new page or heading goes here and into docs/
-together (tests/project/test_docs.py, test_citations.py)."""
+cite a page and one of its headings, in parentheses. A new page or heading goes here and into
+docs/ together (tests/project/test_docs.py, test_citations.py)."""
 from __future__ import annotations
 
 HEADINGS = {
