@@ -31,6 +31,14 @@ FORBIDDEN = {
     "mercmac.emulator": {"cli", "sim", "render"},
     "mercmac.render": {"cli"},
     "mercmac.fmt": {"vm", "upload", "emulator", "sim", "cli", "render"},  # reads the compiler's tokens
+    # what a rig is, read and checked: data and the compiler's checks, never what runs it
+    "mercmac.rig": {"vm", "sim", "upload", "emulator", "cli", "render", "lsp", "decompile",
+                    "fmt"},
+    # words for stored macros: it reads the compiler (and the language server's re-checker,
+    # to check a decompiled source fast), never a port, a simulation or the command line
+    "mercmac.decompile": {"cli", "upload", "emulator", "sim"},
+    # the editor's view of `check`: compiler, fmt, rigs and help texts; nothing that runs
+    "mercmac.lsp": {"cli", "upload", "emulator", "sim", "vm", "decompile"},
 }
 
 
