@@ -25,6 +25,7 @@ from pathlib import Path
 
 from mercmac import mdtext
 from mercmac.compiler import compile_file
+from mercmac.emulator.chain import Chain
 from mercmac.emulator.virtual import Faults, VirtualController
 from mercmac.upload.flasher import FlashOptions, flash
 from mercmac.upload.protocol import command
@@ -74,12 +75,12 @@ def minimum(before: dict[int, str], written: dict[int, str], framing: str = "etx
 
 
 def measure(server: PtyServer, program, backup: Path) -> Count:
-    before = server.call(lambda vc: vc.md_count)
+    before = server.call(lambda chain: chain.controllers[0].md_count)
     with open_controller(server.path, 0, timing=Timing(timeout=0.5, settle=0.05)) as c:
         who = identify(c)
         flash(c, who, program, FlashOptions(backup=backup))
         sent, received = c.transport.sent, c.transport.received
-    return Count(sent, received, server.call(lambda vc: vc.md_count) - before)
+    return Count(sent, received, server.call(lambda chain: chain.controllers[0].md_count) - before)
 
 
 def seconds(n: int) -> float:
@@ -90,7 +91,7 @@ def main(path: Path = EXAMPLE4, framing: str = "etx-per-line") -> dict[str, floa
     program = compile_file(str(path)).program
     lines = {s: m.line for s, m in program.macros.items()}
     with tempfile.TemporaryDirectory() as tmp, \
-            PtyServer(VirtualController(faults=Faults(tm_framing=framing))) as server:
+            PtyServer(Chain([VirtualController(faults=Faults(tm_framing=framing))])) as server:
         full = measure(server, program, Path(tmp) / "full.mcm")
         again = measure(server, program, Path(tmp) / "again.mcm")
     need_full, need_again = minimum({}, lines, framing), minimum(lines, {}, framing)
@@ -115,10 +116,9 @@ def identified(model: str, firmware: str = "2.30") -> int:
 
 def rig_main(path: Path = RASTER, framing: str = "etx-per-line") -> float:
     """A full flash of the rig PATH to an empty chain: bytes against the minimum; the ratio."""
-    from mercmac.emulator.chain import Chain
     from mercmac.rig.open import accept
     from mercmac.upload.protocol import select
-    from mercmac.upload.rig import flash_rig
+    from mercmac.upload.chain import flash_chain
 
     accepted = accept(str(path))
     rig, programs = accepted.rig, accepted.programs
@@ -129,8 +129,8 @@ def rig_main(path: Path = RASTER, framing: str = "etx-per-line") -> float:
     chain = Chain([VirtualController(c.model, c.address, faults=Faults(tm_framing=framing))
                    for c in rig.controllers])
     with tempfile.TemporaryDirectory() as tmp, PtyServer(chain) as server:
-        done = flash_rig(server.path, str(path), timing=Timing(timeout=0.5, settle=0.05),
-                         options=FlashOptions(backup=f"{tmp}/"))
+        done = flash_chain(server.path, str(path), timing=Timing(timeout=0.5, settle=0.05),
+                           options=FlashOptions(backup=f"{tmp}/"))
     total = done.sent + done.received
     print(f"{path.name}: {len(rig.controllers)} controllers on one port, TM framing {framing}")
     print(f"  full flash of the rig to an empty chain: sent {done.sent} B, received "

@@ -141,33 +141,45 @@ def flash(port, file, port_option, address, baud, dry_run, backup, erase_unused,
     FILE may be a rig (NAME.rig.toml): every controller at its address, in one run.
     """
     def work() -> int:
-        nonlocal port, file
         from mercmac.render import upload as view
-        from mercmac.render.console import write_lines
-        from mercmac.upload import backup as backups
         from mercmac.upload import flasher
 
-        given, file = split_flash_args(port, file, port_option)
-        rig = _rig_flash_options(file, only, force=force, target=target)
-        port = _port(given, port_option, "flash")
-        options = flasher.FlashOptions(erase_unused, dry_run, reset, Path(backup) if backup else None)
-        if rig:  # its --backup stays text: 'DIR/' names a folder (upload.rig.backup_paths)
-            options.backup = backup
-            return _flash_rig(port, file, only, baud, timeout, options, finished)
+        given, path = split_flash_args(port, file, port_option)
+        _rig_flash_options(path, only, force=force, target=target)
+        where = _port(given, port_option, "flash")
+        options = flasher.FlashOptions(erase_unused, dry_run, reset, backup)
+        shown = view.FlashShown(where)
         try:
-            result = flasher.flash_file(port, file, address=address, baud=baud,
-                                        timing=_timing(timeout), options=options, target=target,
-                                        force=force, watch=_watch(port, address, finished))
-            address_used = result.identity.address
-        except backups.BackupError as e:
-            raise _unwritable(e) from None
-        if dry_run:
-            write_lines(view.dry_run_lines(result, address_used, baud))
-        write_lines(view.flash_summary(result, port))
-        return EXIT_OK
+            return _flash(where, path, shown, options, baud, timeout, address=address,
+                          target=target, force=force, only=only)
+        except KeyboardInterrupt as e:
+            if shown.done is None:
+                raise
+            from mercmac.upload.errors import FlashInterrupted
 
-    finished = [None]  # the flash once it is complete: a Ctrl-C after that still says so
-    run_guarded(lambda: _reporting_completion(work, finished))
+            raise FlashInterrupted("interrupted while showing the result; "
+                                   f"{view.completed_text(shown.done)}", by=e) from None
+
+    run_guarded(work)
+
+
+def _flash(port: str, path: str, shown, options, baud: int, timeout: float, **asked) -> int:
+    """Flash the program file or rig PATH (upload.chain), shown by SHOWN; then the dry run's
+    bytes and the summary. `asked`: --address, --target, --force, --only."""
+    from mercmac.render import upload as view
+    from mercmac.render.console import write_lines
+    from mercmac.upload import backup as backups
+    from mercmac.upload import chain
+
+    try:
+        flash = chain.flash_chain(port, path, baud=baud, timing=_timing(timeout),
+                                  options=options, watch=shown, **asked)
+    except backups.BackupError as e:
+        raise _unwritable(e) from None
+    if options.dry_run:
+        write_lines(view.dry_run_lines(flash, baud))
+    write_lines(view.flash_summary(flash, port))
+    return EXIT_OK
 
 
 def only_names(values: tuple[str, ...]) -> list[str] | None:
@@ -183,15 +195,15 @@ def only_names(values: tuple[str, ...]) -> list[str] | None:
     return list(dict.fromkeys(names))
 
 
-def _rig_flash_options(file: str, only, *, force: bool, target) -> bool:
-    """Whether FILE is a rig; UsageError for options that do not go with it (or without)."""
+def _rig_flash_options(file: str, only, *, force: bool, target) -> None:
+    """UsageError for options that do not go with a rig (or without one)."""
     from mercmac.rig import is_rig_path
 
     if not is_rig_path(file):
         if only is not None:
             raise UsageError("--only chooses controllers of a rig; FILE is no rig file",
                              hint="mercmac flash [PORT] NAME.rig.toml --only x,y")
-        return False
+        return
     given = click.get_current_context().get_parameter_source
     default = click.core.ParameterSource.DEFAULT
     for name, used in (("--address", given("address") is not default), ("--force", force),
@@ -199,117 +211,6 @@ def _rig_flash_options(file: str, only, *, force: bool, target) -> bool:
         if used:
             raise UsageError(f"{name} does not go with a rig: the rig file gives each "
                              f"controller's address and model", hint=f"edit {file}")
-    return True
-
-
-def _flash_rig(port: str, file: str, only, baud: int, timeout: float, options, finished) -> int:
-    """`flash [PORT] RIG`: every controller of the rig, one table (mercmac.upload.rig)."""
-    from mercmac.render import upload as view
-    from mercmac.render.console import write_lines
-    from mercmac.upload import backup as backups
-    from mercmac.upload import rig
-
-    try:
-        result = rig.flash_rig(port, file, only=only, baud=baud, timing=_timing(timeout),
-                               options=options, watch=_rig_watch(port, finished))
-    except backups.BackupError as e:
-        raise _unwritable(e) from None
-    if options.dry_run:
-        write_lines(view.rig_dry_run_lines(result, baud))
-    write_lines(view.rig_summary(result, port))
-    return EXIT_OK
-
-
-def _rig_watch(port: str, finished: list):
-    """What `flash RIG` shows: diagnostics, who answered at each address, progress."""
-    from contextlib import contextmanager
-
-    from mercmac.render import report as render
-    from mercmac.render import upload as view
-    from mercmac.render.console import write_lines
-    from mercmac.upload import rig
-
-    class Shown(rig.RigWatch):
-        def refused_rig(self, findings) -> None:
-            render.write_findings(findings, sys.stderr)
-
-        def compiled(self, compilation) -> None:
-            render.write_warnings(compilation)
-
-        def identified(self, part, warning) -> None:
-            write_lines(view.identity_lines(port, part.member.address, part.identity, warning,
-                                            name=part.name))
-
-        @contextmanager
-        def meeting(self, part):
-            with view.FlashProgress() as progress:
-                yield progress
-
-        @contextmanager
-        def writing(self, part):
-            write_lines(view.rig_writing_lines(part))
-            with view.FlashProgress() as progress:
-                yield progress
-
-        def finished(self, result) -> None:
-            finished[0] = result
-
-    return Shown()
-
-
-def _reporting_completion(work, finished) -> int:
-    """Run `work`; a Ctrl-C once the flash is complete (closing, printing) says what was done."""
-    try:
-        return work()
-    except KeyboardInterrupt as e:
-        if finished[0] is None:
-            raise
-        from mercmac.render.upload import completed_text
-        from mercmac.upload.errors import FlashInterrupted
-
-        raise FlashInterrupted("interrupted while showing the result; "
-                               f"{completed_text(finished[0])}", by=e) from None
-
-
-def _watch(port: str, address: int | None, finished: list):
-    """What `flash` shows while flashing: diagnostics, who answered, a progress bar."""
-    from contextlib import contextmanager
-
-    from mercmac.render import report as render
-    from mercmac.render import upload as view
-    from mercmac.render.console import write_lines
-    from mercmac.upload import flasher
-
-    searched = [False]  # no --address, nothing at 0: addresses 1-15 were searched
-
-    class Shown(flasher.Watch):
-        def refused(self, compilation) -> None:
-            render.write_errors(compilation)  # on standard error, before the refusal
-
-        def compiled(self, compilation) -> None:
-            render.write_warnings(compilation)  # on standard error; the flash goes on
-
-        @contextmanager
-        def searching(self):
-            with _searching() as shown:
-                def probing(n: int) -> None:
-                    searched[0] = True
-                    shown(n)
-                yield probing
-
-        def identified(self, identity, warning) -> None:
-            write_lines(view.identity_lines(port, identity.address, identity, warning,
-                                            searched=searched[0]))
-
-        @contextmanager
-        def writing(self):
-            with view.FlashProgress() as progress:
-                yield progress
-
-        def finished(self, result) -> None:
-            finished[0] = result  # a Ctrl-C from here on still says what was done
-
-    return Shown()
 
 
 @click.command()
@@ -354,7 +255,7 @@ def pull(port, port_option, output, address, baud, timeout, raw, rig_dir, force)
         if to_file:
             _check_output(Path(output))  # refused before reading, which stops a running macro
         pulled = survey.pull_file(port, address=address, baud=baud, timing=_timing(timeout),
-                                  searching=_searching)
+                                  searching=view.looking_for_address)
         address = pulled.identity.address
         text, found = pulled.text, None
         if not raw:  # a program mercmac flashed comes back as its source (upload.history)
@@ -432,13 +333,6 @@ def _listed(paths: list[Path]) -> str:
     """'x.mcm, y.mcm and r.rig.toml': the files a folder holds already, by name."""
     names = [p.name for p in paths]
     return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} and {names[-1]}"
-
-
-def _searching():
-    """No --address: the address probed, while looking for the controller (survey.reach)."""
-    from mercmac.render import upload as view
-
-    return view.AddressProgress(sys.stderr, "no --address: looking for the controller")
 
 
 def history_records() -> list:
@@ -590,18 +484,19 @@ def emulate(target, address, addresses, rig_path, state, firmware, tm_framing, e
         from mercmac.outfile import appending, reason
 
         faults = Faults(tm_framing=tm_framing, empty_slot=empty_slot, pace=pace, baud=baud)
-        vc = _virtual(target.upper(), address, addresses, rig_path, firmware=firmware,
-                      faults=faults, state=Path(state) if state else None)
+        served = _virtual(target.upper(), address, addresses, rig_path, firmware=firmware,
+                          faults=faults, state=Path(state) if state else None)
         # a device, FIFO or folder is refused here, before the pseudo-terminal exists
         with appending(log_file) if log_file else nullcontext() as log:
             try:
-                server = PtyServer(vc, log)
+                server = PtyServer(served, log)
             except OSError as e:
                 raise UsageError(f"cannot create a pseudo-terminal: {reason(e)}") from None
             kept = f", macros kept in {printable(state)}" if state else ""
             paced = f", paced at {baud} baud" if pace else ""
             logged = f", bytes logged to {printable(log_file)}" if log_file else ""
-            click.echo(f"{_served(vc, firmware)}{kept}{paced}{logged}")
+            click.echo(f"{_served(served, firmware, one=addresses is None and rig_path is None)}"
+                       f"{kept}{paced}{logged}")
             click.echo(server.path)
             try:
                 server.serve_forever()
@@ -616,9 +511,9 @@ def emulate(target, address, addresses, rig_path, state, firmware, tm_framing, e
 
 def _virtual(model: str, address: int, addresses: tuple[int, ...] | None, rig_path: str | None,
              **kw):
-    """What `emulate` serves: one controller, a chain at --addresses, or a --rig's chain."""
+    """What `emulate` serves: a chain of one controller, a chain at --addresses, or a --rig's
+    chain."""
     from mercmac.emulator import chain
-    from mercmac.emulator.virtual import VirtualController
 
     given = click.get_current_context().get_parameter_source
     chosen = [name for name, param in (("--addresses", "addresses"), ("--rig", "rig_path"),
@@ -633,7 +528,7 @@ def _virtual(model: str, address: int, addresses: tuple[int, ...] | None, rig_pa
         return chain.for_rig(_emulated_rig(rig_path), **kw)
     if addresses is not None:
         return chain.at_addresses(addresses, model, **kw)
-    return VirtualController(model, address, **kw)
+    return chain.of_one(model, address, **kw)
 
 
 def _emulated_rig(path: str):
@@ -650,11 +545,11 @@ def _emulated_rig(path: str):
         raise kind(f"--rig: {e.message}; nothing is served", hint=e.hint) from None
 
 
-def _served(vc, firmware: str) -> str:
-    """The first line `emulate` prints: what is served, at which addresses."""
-    from mercmac.emulator.chain import Chain
-
-    if not isinstance(vc, Chain):
-        return f"virtual {vc.model} (firmware {firmware}) at address {vc.address}"
+def _served(chain, firmware: str, *, one: bool) -> str:
+    """The first line `emulate` prints: what is served, at which addresses; `one`: the one
+    controller of --address, not a chain (--addresses, --rig) however long."""
+    if one:
+        c = chain.controllers[0]
+        return f"virtual {c.model} (firmware {firmware}) at address {c.address}"
     return f"virtual chain (firmware {firmware}): " + ", ".join(
-        f"{c.model} at address {vc.label(c.address)}" for c in vc.controllers)
+        f"{c.model} at address {chain.label(c.address)}" for c in chain.controllers)

@@ -119,6 +119,11 @@ class Chain:
         self.by_address(address).run_safely(work)
 
 
+def of_one(model: str, address: int, **kw) -> Chain:
+    """`emulate --address N`: one controller, a chain of one (its `state` a file)."""
+    return Chain([VirtualController(model, address, **kw)])
+
+
 def at_addresses(addresses: Sequence[int], model: str, *, firmware: str = "2.30",
                  faults: Faults | None = None, state: Path | None = None) -> Chain:
     """`emulate --addresses 0,1,2`: one controller of `model` at each address; with a

@@ -1,10 +1,11 @@
-"""Serving a virtual controller on a pseudo-terminal: the path opens like a serial port.
+"""Serving virtual controllers on a pseudo-terminal: the path opens like a serial port.
 
 POSIX only (os.openpty). The server keeps its own handle on the terminal
 side open, so hosts may open and close the path as often as they like, and
 a `vanish` fault closes both ends to look like a pulled USB cable. With a
-log, every byte both ways goes to it as it passes, timestamped; on a chain of several
-controllers (chain.py) each line also says which controller was selected or answered.
+log, every byte both ways goes to it as it passes, timestamped. What is served is a chain
+(chain.py): one controller is a chain of one; on a chain of several each line of the log also
+says which controller was selected or answered.
 """
 from __future__ import annotations
 
@@ -17,7 +18,6 @@ import tty
 from typing import IO, Callable
 
 from mercmac.emulator.chain import Chain
-from mercmac.emulator.virtual import VirtualController
 from mercmac.outfile import reason
 from mercmac.upload.protocol import show
 
@@ -26,15 +26,14 @@ log = logging.getLogger(__name__)
 
 
 class PtyServer:
-    """A VirtualController (or a Chain of them) behind a pty; `path` is what to give
+    """A Chain of virtual controllers (one, or several) behind a pty; `path` is what to give
     `mercmac flash`."""
 
-    def __init__(self, controller: VirtualController | Chain, log: IO[str] | None = None,
+    def __init__(self, chain: Chain, log: IO[str] | None = None,
                  clock: Callable[[], float] = time.monotonic):
         if not hasattr(os, "openpty"):
             raise OSError("pseudo-terminals need a POSIX system (Linux, macOS)")
-        self.controller = controller  # what `call` hands over
-        self.chain = controller if isinstance(controller, Chain) else Chain([controller])
+        self.chain = chain
         self._master, self._slave = os.openpty()
         tty.setraw(self._slave)  # no echo, no CR->LF translation: bytes pass unchanged
         os.set_blocking(self._master, False)  # a host that stops reading must not stall us
@@ -104,9 +103,9 @@ class PtyServer:
             return b"", False
 
     def call(self, fn):
-        """Run `fn(controller)` between bytes, e.g. to press a button from a test."""
+        """Run `fn(chain)` between bytes, e.g. to press a button from a test."""
         with self._lock:
-            return fn(self.controller)
+            return fn(self.chain)
 
     def close(self) -> None:
         """Stop serving; the serving thread closes the pty as it ends (never under its feet)."""

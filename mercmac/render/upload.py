@@ -1,12 +1,14 @@
 """The uploader's text: identification, progress, the flash summary, dry runs, pull, scan, ports.
 
 Plain lines when the output is not a terminal (logs, CI); a rich progress bar
-and colour on a terminal (render/console.py decides, NO_COLOR honoured).
+and colour on a terminal (render/console.py decides, NO_COLOR honoured). A program file's
+flash is shown as one controller's (its slots); a rig's with a row per controller.
 """
 from __future__ import annotations
 
 import os
 import sys
+from contextlib import ExitStack, contextmanager, nullcontext
 from typing import IO
 
 from mercmac.mdtext import slot_name
@@ -14,6 +16,7 @@ from mercmac.names import printable
 from mercmac.render.console import Line, rich_console, table, use_colour, write_lines
 from mercmac.render.sim import plural
 from mercmac.timespec import format_clock
+from mercmac.upload.chain import Watch
 from mercmac.upload.flasher import Event, EventKind
 
 _FATE_STYLE = {"written": "bold green", "erased": "bold yellow", "re-written last": "green",
@@ -143,6 +146,89 @@ class AddressProgress:
             self.shown = True
 
 
+class FlashShown(Watch):
+    """What `flash` shows while it flashes a program file or a rig: diagnostics, who answered
+    at each address, progress; it keeps the finished flash (a Ctrl-C while it is shown still
+    says what was done) and whether the address was found by a search."""
+
+    def __init__(self, port: str):
+        self.port = port
+        self.done = None  # the finished flash (upload.chain.Flash)
+        self.searched = False  # no --address, nothing at 0: addresses 1-15 were searched
+        self._probing: AddressProgress | None = None
+        self._open: ExitStack | None = None  # what `flashing` closes: a program file's bar
+        self._bar: FlashProgress | None = None
+
+    def refused(self, findings) -> None:
+        from mercmac.render.report import write_findings
+
+        write_findings(findings, sys.stderr)  # as `check` shows them, before the refusal
+
+    def compiled(self, compilation) -> None:
+        from mercmac.render.report import write_warnings
+
+        write_warnings(compilation)  # on standard error; the flash goes on
+
+    @contextmanager
+    def searching(self):
+        with looking_for_address() as self._probing:
+            yield self._probe
+
+    def _probe(self, address: int) -> None:
+        self.searched = True
+        self._probing(address)
+
+    def identified(self, part, warning) -> None:
+        write_lines(identity_lines(self.port, part.address, part.identity, warning,
+                                   searched=self.searched, name=part.name or "controller"))
+
+    @contextmanager
+    def flashing(self, flash):
+        with ExitStack() as self._open:
+            try:
+                yield
+            finally:
+                self._bar = None  # the stack closes it
+
+    @contextmanager
+    def meeting(self, part):
+        with self._progress(part) as progress:
+            yield progress
+
+    @contextmanager
+    def writing(self, part):
+        if part.name:  # a rig's controller: which one, and what it gets
+            write_lines(rig_writing_lines(part))
+        with self._progress(part) as progress:
+            yield progress
+
+    @contextmanager
+    def resetting(self, flash):
+        if flash.named:  # the rig's summary says RT went to each
+            yield lambda event: None
+            return
+        with self._progress(flash.parts[0]) as progress:
+            yield progress
+
+    def _progress(self, part):
+        """A bar for each controller of a rig and each phase; for a program file's controller
+        one bar from its backup until the flash is finished (`flashing` closes it), so that a
+        Ctrl-C while it closes finds the flash finished."""
+        if part.name:
+            return FlashProgress()
+        if self._bar is None:
+            self._bar = self._open.enter_context(FlashProgress())
+        return nullcontext(self._bar)
+
+    def finished(self, flash) -> None:
+        self.done = flash  # a Ctrl-C from here on still says what was done
+
+
+def looking_for_address() -> AddressProgress:
+    """No --address: the address probed, while looking for the controller (survey.reach)."""
+    return AddressProgress(sys.stderr, "no --address: looking for the controller")
+
+
 def _rate_text(sent: int, size: int, seconds: float) -> str:
     """'38 B/s, 00:00:12 left' once some bytes went out; '' before (a line redrawn in place)."""
     if sent <= 0 or seconds <= 0:
@@ -165,7 +251,15 @@ def _event_line(event: Event) -> Line:
             return [(event.text, "")]
 
 
-def flash_summary(result, port: str) -> list[Line]:
+def flash_summary(flash, port: str) -> list[Line]:
+    """A finished flash: a rig's controller table, or a program file's slot table; and the
+    outcome."""
+    if flash.named:
+        return _rig_summary(flash, port)
+    return _slot_summary(flash.parts[0].result)
+
+
+def _slot_summary(result) -> list[Line]:
     """The slot table and the outcome line."""
     plan = result.plan
     dry = result.dry_run
@@ -219,11 +313,12 @@ def _kept(n: int, dry_run: bool) -> str:
     return "would be kept" if dry_run else "was kept" if n == 1 else "were kept"
 
 
-def completed_text(result) -> str:
+def completed_text(flash) -> str:
     """The outcome of a finished flash in plain words, for a Ctrl-C while it is being shown."""
-    if hasattr(result, "parts"):  # a rig (mercmac.upload.rig.RigResult)
+    if flash.named:
         return "the rig flash had finished:\n" + "\n".join(
-            f"  {p.name} (address {p.member.address}): {p.state.value}" for p in result.parts)
+            f"  {p.name} (address {p.address}): {p.state.value}" for p in flash.parts)
+    result = flash.parts[0].result
     if result.dry_run:
         return f"dry run complete, nothing was written; {_would(result.plan)}"
     reset = "; RT was sent, macro 0 is starting" if result.reset else ""
@@ -255,11 +350,13 @@ def _would(plan) -> str:
     return "a flash would " + ", ".join(_WOULD_TALLY[what].format(n=n) for what, n in counts.items())
 
 
-def dry_run_lines(result, address: int | None, baud: int) -> list[Line]:
-    """Every byte a real flash would now send, and what for."""
-    if result.plan.changes_nothing:
-        return [[("nothing to send: ", "bold"), ("the controller already holds this program", "")]]
-    return wire_lines(result.wire(address), baud)
+def dry_run_lines(flash, baud: int) -> list[Line]:
+    """Every byte a real flash would now send, selection codes included, and what for."""
+    if flash.changes_nothing:
+        held = ("every controller already holds its program" if flash.named
+                else "the controller already holds this program")
+        return [[("nothing to send: ", "bold"), (held, "")]]
+    return wire_lines(flash.wire(), baud)
 
 
 def wire_lines(wire: list[tuple[bytes, str]], baud: int) -> list[Line]:
@@ -314,21 +411,12 @@ def _name(name: str | None, slot: int) -> str:
     return name.replace(f" ({tag})", "")
 
 
-# -- rigs (mercmac.upload.rig) ---------------------------------------------------------------
+# -- rigs (mercmac.upload.chain, a Flash with names) ------------------------------------------
 
-def rig_dry_run_lines(result, baud: int) -> list[Line]:
-    """Every byte a rig flash would now send, selection codes included, and what for."""
-    if result.changes_nothing:
-        return [[("nothing to send: ", "bold"), ("every controller already holds its program", "")]]
-    return wire_lines(result.wire(), baud)
-
-
-def rig_summary(result, port: str) -> list[Line]:
+def _rig_summary(result, port: str) -> list[Line]:
     """A row per controller of the rig, and the outcome line."""
-    import os
-
-    rows = [(p.name, str(p.member.address), p.member.model,
-             printable(os.path.basename(p.member.program)), _rig_cell(p, result.dry_run),
+    rows = [(p.name, str(p.address), p.model,
+             printable(os.path.basename(p.program)), _rig_cell(p, result.dry_run),
              printable(str(p.result.backup)) if p.result and p.result.backup else "-")
             for p in result.parts]
     rig = printable(result.rig.name)
@@ -360,7 +448,7 @@ def rig_writing_lines(part) -> list[Line]:
     plan = part.result.plan
     what = ("nothing to write: it holds its program" if plan.changes_nothing
             else f"{plural(len(plan.steps), 'step')}, macro 0 last")
-    return [[(f"{part.name} (address {part.member.address}): ", "bold"), (what, "")]]
+    return [[(f"{part.name} (address {part.address}): ", "bold"), (what, "")]]
 
 
 def _rig_cell(part, dry_run: bool) -> str:

@@ -1,28 +1,27 @@
-"""Flashing a program: back up, write what differs in the safe order, verify, report.
+"""Flashing one controller: back up, write what differs in the safe order, verify, report.
 
-The steps of docs/uploader.md, "A flash, step by step". The controller is identified
-first (session.identify); everything it holds is saved before the first write; each write
-is read back, written once more on a mismatch, and a failure stops the flash with a message
-that says what was written, what was not, and where the backup is.
+The steps of docs/uploader.md, "A flash, step by step", for a controller already identified
+(connect.identify); chain.py runs them for a program file or every controller of a rig.
+Everything the controller holds is saved before the first write; each write is read back,
+written once more on a mismatch, and a failure stops the flash with a message that says what
+was written, what was not, and where the backup is.
 """
 from __future__ import annotations
 
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
-from typing import Callable, Iterator
+from typing import Callable
 
-from mercmac.compiler import Compilation, compile_file
+from mercmac.compiler import Compilation
 from mercmac.compiler.program import Program
 from mercmac import mdtext
 from mercmac.errors import how, signal_of
-from mercmac.upload import backup, protocol, survey
+from mercmac.upload import backup, protocol
 from mercmac.upload.controller import Controller, ControllerError, LinkLost
 from mercmac.upload.errors import FlashFailed, FlashInterrupted, Refused
 from mercmac.upload.plan import Action, Plan, Step, make_plan
-from mercmac.upload.connect import Identity, check_model, identify, open_controller, refusal
-from mercmac.upload.transport import DEFAULT_BAUD, Timing
+from mercmac.upload.connect import Identity, refusal
 
 CLEANUP_TIMEOUT = 0.5  # s: after Ctrl-C, how long one tidy-up read may take
 
@@ -60,7 +59,9 @@ class FlashOptions:
     erase_unused: bool = False
     dry_run: bool = False
     reset: bool = False
-    backup: Path | None = None
+    # --backup: one controller's file; for a rig a folder or a prefix (rig.backup_paths), kept
+    # as given, since a str's ending separator names a folder
+    backup: Path | str | None = None
 
 
 @dataclass(slots=True)
@@ -90,83 +91,18 @@ class FlashResult:
         """The exact bytes a flash sends after reading back, with what each is for."""
         address = self.identity.address if address is None else address
         out = [(protocol.select(address), "address selection (0x01 + address)")]
-        for step in self.plan.steps:
-            out.append((protocol.command(step.wire), step.describe))
-            out.append((protocol.command(step.readback), f"read back {step.name}"))
+        out += self.steps_wire()
         if self.reset:
             out.append((protocol.command(mdtext.rt()), "reset: macro 0 starts"))
         return out
 
-
-class Watch:
-    """What `flash_file` tells its caller, in order; each part does nothing unless overridden."""
-
-    def refused(self, compilation: Compilation) -> None:
-        """The file has errors (for the controller's model): shown before the refusal."""
-
-    @contextmanager
-    def searching(self) -> Iterator[Callable[[int], None]]:
-        """No --address and nothing at 0: around the search of 1-15; yields where each goes."""
-        yield lambda address: None
-
-    def compiled(self, compilation: Compilation) -> None:
-        """The file as it will be flashed (no errors; it may have warnings to show)."""
-
-    def identified(self, identity: Identity, warning: str | None) -> None:
-        """The controller answered and fits the program; `warning`: it does not (--force)."""
-
-    @contextmanager
-    def writing(self) -> Iterator[Notify]:
-        """Around the backup, the writes and their verification; yields where events go."""
-        yield lambda event: None
-
-    def finished(self, result: FlashResult) -> None:
-        """The flash is complete; the port is still open (closing it may yet be cut short)."""
-
-
-def flash_file(port: str, path: str, *, address: int | None = 0, baud: int = DEFAULT_BAUD,
-               timing: Timing = Timing(), options: FlashOptions | None = None,
-               target: str | None = None, force: bool = False,
-               watch: Watch | None = None) -> FlashResult:
-    """Flash the .mcm file PATH to the controller at `address` on PORT (docs/uploader.md).
-
-    A file without `target` (and no `target` given) is compiled again for the model
-    that answers, so that it is checked against that controller; a model other than
-    the program's is refused unless `force`. `address` None: 0 if anything answers there,
-    else the only address that answers (survey.reach). Refused, FlashFailed, FlashInterrupted or
-    PortError say what happened; backup.BackupError: `options.backup` cannot be written
-    or the default backups' folder cannot be written (checked before the port is opened);
-    OSError: the file cannot be read.
-    """
-    watch = watch or Watch()
-    options = options or FlashOptions()
-    compiled = _compile(path, target, watch)
-    program = compiled.program
-    if program.target is not None:  # else compiled again below, for the model that answers
-        watch.compiled(compiled)
-    if options.backup is not None:
-        backup.check(options.backup)  # a device, FIFO or folder: refused before the port opens
-    elif not options.dry_run:
-        backup.check_default()  # an unwritable data folder too: the same I/O problem (exit 2)
-    with open_controller(port, address or 0, baud=baud, timing=timing) as c:
-        try:
-            survey.reach(c, address, watch.searching)  # as pull_file finds it
-            who = identify(c)
-            if program.target is None:
-                compiled = _compile(path, who.version.model, watch)
-                program = compiled.program
-                watch.compiled(compiled)
-            watch.identified(who, check_model(who, program.target, path, force=force))
-        except KeyboardInterrupt as e:
-            raise FlashInterrupted("interrupted before the first write; nothing was written",
-                                   by=e) from None
-        with watch.writing() as notify:
-            result = flash(c, who, program, options, notify)
-            result.restoring = _is_backup(path)
-            if not options.dry_run:
-                result.recorded = record(c, who, compiled, result)
-            watch.finished(result)
-    return result
+    def steps_wire(self) -> list[tuple[bytes, str]]:
+        """The plan's steps on the wire: each command and its read-back, with what it is for."""
+        out = []
+        for step in self.plan.steps:
+            out.append((protocol.command(step.wire), step.describe))
+            out.append((protocol.command(step.readback), f"read back {step.name}"))
+        return out
 
 
 def record(controller: Controller, identity: Identity, compiled: Compilation,
@@ -190,39 +126,22 @@ def record(controller: Controller, identity: Identity, compiled: Compilation,
         return None
 
 
-def _is_backup(path: str) -> bool:
-    """Whether PATH was written by `mercmac pull` or a flash's backup (backup.to_mcm's header)."""
-    try:
-        with open(path, encoding="utf-8", errors="replace") as f:
-            head = [f.readline() for _ in range(2)]
-    except OSError:
-        return False
-    return head[0].startswith("// Mercury(TM) Macro File") and head[1].startswith("// read by mercmac")
-
-
-def _compile(path: str, target: str | None, watch: Watch) -> Compilation:
-    """PATH compiled for `target`; Refused (after `watch.refused`) if it has errors."""
-    compilation = compile_file(path, target=target)
-    if compilation.report.has_errors or compilation.program is None:
-        watch.refused(compilation)
-        against = f" for the {target}" if target else ""
-        raise Refused(f"{path} has errors{against}; nothing was flashed")
-    return compilation
-
-
 def flash(controller: Controller, identity: Identity, program: Program,
           options: FlashOptions, notify: Notify = lambda e: None) -> FlashResult:
-    """Read back, back up, write and verify; FlashFailed names the state on any failure."""
+    """Read back, back up, write and verify (and RT with `options.reset`); FlashFailed names
+    the state on any failure."""
     result = prepare(controller, identity, program, options, notify)
     if not options.dry_run:
         write(controller, result, notify)
+        if result.reset:
+            reset(controller, result, notify)
     return result
 
 
 def prepare(controller: Controller, identity: Identity, program: Program,
             options: FlashOptions, notify: Notify = lambda e: None) -> FlashResult:
-    """Read back, plan and (unless a dry run) back up: nothing is written yet. A rig backs up
-    every controller this way before it writes to any (mercmac.upload.rig)."""
+    """Read back, plan and (unless a dry run) back up: nothing is written yet. A chain backs
+    up every controller this way before it writes to any (chain.py)."""
     result = None
     try:
         stored = controller.read_all()  # TM, TZ: all of it, before any write
@@ -243,11 +162,29 @@ def prepare(controller: Controller, identity: Identity, program: Program,
 
 
 def write(controller: Controller, result: FlashResult, notify: Notify = lambda e: None) -> None:
-    """Carry out a prepared plan: write, verify, macro 0 last; RT when `result.reset`."""
-    run = _Run(controller, result.plan, notify, result)
-    run.execute()
-    if result.reset:
-        run.reset()
+    """Carry out a prepared plan: write, verify, macro 0 last."""
+    _Run(controller, result.plan, notify, result).execute()
+
+
+def reset(controller: Controller, result: FlashResult, notify: Notify = lambda e: None, *,
+          select: bool = False) -> None:
+    """RT once the plan is written and verified, so macro 0 starts as after power-on; the
+    controller is then deselected (MS176E §6.4 RT, §3.1). `select`: send its selection code
+    first (another controller of the chain was addressed since)."""
+    try:
+        if select:
+            controller.select()  # 0x01 + address: the others ignore the RT (§3.2)
+        controller.reset()
+    except ControllerError as e:
+        raise FlashFailed(f"all macros are written and verified, but RT failed: {failure(e)}",
+                          hint="power-cycle the controller to start macro 0") from None
+    except KeyboardInterrupt as e:
+        raise FlashInterrupted(f"all macros are written and verified (backup: "
+                               f"{result.backup}); interrupted while sending RT, so "
+                               f"macro 0 may not have started",
+                               hint="power-cycle the controller to start macro 0",
+                               by=e) from None
+    notify(Event(EventKind.RESET, "RT sent: the controller restarts and runs macro 0"))
 
 
 def _save_backup(controller: Controller, identity: Identity, stored: dict[int, str],
@@ -292,7 +229,7 @@ class _Run:
             self.verify_failed = True
             cause, alive, by = e.args[0], True, None
         except ControllerError as e:
-            cause, alive, by = _cause(e), not isinstance(e, LinkLost), None
+            cause, alive, by = failure(e), not isinstance(e, LinkLost), None
         else:
             return
         # Inline, with no call before the `try`: a second signal, pending since the first,
@@ -312,20 +249,6 @@ class _Run:
             return FlashFailed(self._report(cause, alive=alive), hint=self._hint())
         cause = f"interrupted ({how(signal_of(by))})"
         return FlashInterrupted(self._report(cause, alive=alive), hint=self._hint(), by=by)
-
-    def reset(self) -> None:
-        try:
-            self.c.reset()  # RT: macro 0 starts as after power-on (MS176E §6.4 RT)
-        except ControllerError as e:
-            raise FlashFailed(f"all macros are written and verified, but RT failed: {_cause(e)}",
-                              hint="power-cycle the controller to start macro 0") from None
-        except KeyboardInterrupt as e:
-            raise FlashInterrupted(f"all macros are written and verified (backup: "
-                                   f"{self.result.backup}); interrupted while sending RT, so "
-                                   f"macro 0 may not have started",
-                                   hint="power-cycle the controller to start macro 0",
-                                   by=e) from None
-        self.notify(Event(EventKind.RESET, "RT sent: the controller restarts and runs macro 0"))
 
     def _apply(self, step: Step) -> None:
         """Send, read back; on a mismatch repair what a lost character hit and send once more."""
@@ -440,7 +363,8 @@ def _names(steps: list[Step]) -> str:
     return ", ".join(f"{s.name}{tags[s.action]}" for s in steps)
 
 
-def _cause(e: ControllerError) -> str:
+def failure(e: ControllerError) -> str:
+    """A controller error as the reports say it: a lost port is named as such."""
     if isinstance(e, LinkLost):
         return f"the port went away ({e})"
     return str(e)

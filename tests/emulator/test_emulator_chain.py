@@ -29,7 +29,7 @@ END = b"\r\n\x03"  # CR LF ETX after every report (MS176E §6.1.3)
 @contextmanager
 def served(*controllers: VirtualController, log=None):
     with PtyServer(chain.Chain(controllers), log) as server:
-        yield server, server.controller
+        yield server, server.chain
 
 
 def answers(port, data: bytes, n: int = 1, seconds: float = ROOM_S) -> list[bytes]:

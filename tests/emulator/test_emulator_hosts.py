@@ -99,7 +99,7 @@ def test_an_etx_after_each_cr_is_ignored():
         assert status(port, b"TS\r\x03").error == 0
         port.write(b"EM3\r\x03")  # the ETX must not stop the macro it just started
         assert until(server.served)  # both read
-        assert eventually(server, lambda v: v.machine.macro == 3)
+        assert eventually(server, lambda _c: vc.machine.macro == 3)
 
 
 # -- TS: "macro running" and the error code -------------------------------------------------
@@ -120,7 +120,7 @@ def test_a_stored_macro_that_runs_is_reported(model, flags):
     with serve(model=model, macros={0: "SC0,WA5000"}) as (server, vc), raw_port(server) as port:
         running = status(port, b"%")  # SC0 selected it; % does not stop the macro (§6.3)
         assert running.macro_running and running.blocks[flags] & 0x10
-        assert server.call(lambda v: v.machine.macro) == 0
+        assert server.call(lambda _c: vc.machine.macro) == 0
 
 
 @pytest.mark.parametrize("model", ["C-863", "C-663"])
@@ -232,7 +232,7 @@ def test_paced_link_loses_characters_typed_at_full_speed_during_a_move():
         typed(server, port, b"TT\r", clock, 0)  # at full speed: at one instant
         clock.advance(0.05)  # time for an answer to be paced out, if there were one
         assert read_for(port) == b""  # 'T' taken, the next one lost: "T" + CR, error 06
-        assert server.call(lambda v: v.lost) >= 1
+        assert server.call(lambda _c: vc.lost) >= 1
         typed(server, port, b"'", clock, 0.05)
         assert replies(port, 1)[0].startswith(b"P:")  # one character alone gets through
         typed(server, port, b"TT\r", clock, 0.005)  # slower than the receiver, faster than 20 ms
@@ -305,4 +305,4 @@ def test_basil_daq_mercury_driver(write_termination):
             mercury.set_position(3000, board_number=0, wait=True)  # polls TP until it stays
             assert mercury.get_position(0) == 3000
             mercury.abort(0)
-        assert eventually(server, lambda v: {"MN", "MA5000", "TS", "MA3000", "AB"} <= set(v.lines))
+        assert eventually(server, lambda _c: {"MN", "MA5000", "TS", "MA3000", "AB"} <= set(vc.lines))

@@ -170,7 +170,7 @@ def test_over_a_pty_bad_arguments_and_endless_lines_leave_it_serving():
         assert protocol.parse_status(read_for(port, 0.5).decode()).error == 0x02
         port.write(b"VE\r")
         assert b"Physik Instrumente" in read_for(port, 0.3)
-        assert server.call(lambda v: (v.macros, len(v._line))) == (STORED, 0)
+        assert server.call(lambda _c: (vc.macros, len(vc._line))) == (STORED, 0)
 
 
 @needs_pty
@@ -185,7 +185,7 @@ def test_the_serve_loop_survives_an_exception():
                 raise RuntimeError("a bug in tick")
             real(now)
 
-        server.call(lambda v: setattr(v, "tick", flaky))
+        server.call(lambda _c: setattr(vc, "tick", flaky))
         port.write(SELECT + b"VE\r")
         assert b"Physik Instrumente" in read_for(port, 0.3)
         assert len(calls) > 3

@@ -46,7 +46,7 @@ def test_idle_is_false_while_the_host_has_an_answer_to_read():
     with serve() as (server, vc), raw_port(server) as port:
         assert until(server.idle)
         port.write(b"\x010TP\r")
-        assert eventually(server, lambda _c: "TP" in _c.lines, seconds=WAIT_S)
+        assert eventually(server, lambda _c: "TP" in vc.lines, seconds=WAIT_S)
         assert not server.idle()  # "P:+0000000000" waits in the pty for the host
         assert port.read_until(b"\x03").endswith(b"\x03")
         assert until(server.idle)

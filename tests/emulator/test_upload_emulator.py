@@ -95,7 +95,7 @@ def test_a_running_macro_reports_and_any_character_stops_it_but_percent_does_not
         port.write(b"%")
         assert b"S:" in read_for(port, 0.1) and vc.running
         port.write(b"x")  # MS176E §3.8.3: "just send a character, e.g. x"
-        assert eventually(server, lambda v: not v.running)
+        assert eventually(server, lambda _c: not vc.running)
         read_for(port, 0)  # the reports it made before it stopped
         assert read_for(port, 0.1) == b""
 

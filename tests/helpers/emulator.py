@@ -7,6 +7,7 @@ from contextlib import contextmanager
 
 import serial
 
+from mercmac.emulator.chain import Chain
 from mercmac.emulator.ptyserver import PtyServer
 from mercmac.emulator.virtual import Faults, VirtualController
 from mercmac.upload import controller as controller_module, transport as transport_module
@@ -31,10 +32,11 @@ ROOM_S = 20.0  # how long an event that comes at once on a quiet machine may tak
 
 @contextmanager
 def serve(clock=time.monotonic, **kw):
-    """A virtual controller on a pty: yields (server, controller); `clock` is its time."""
+    """A virtual controller (a chain of one) on a pty: yields (server, controller); `clock` is
+    its time."""
     faults = kw.pop("faults", None) or Faults()
     vc = VirtualController(faults=faults, **kw)
-    with PtyServer(vc, clock=clock) as server:
+    with PtyServer(Chain([vc]), clock=clock) as server:
         yield server, vc
 
 
@@ -166,7 +168,7 @@ def timeouts(monkeypatch) -> list[str]:
 
 
 def eventually(server, check, seconds: float = ROOM_S) -> bool:
-    """Whether check(controller) becomes true: the emulator reads bytes in its own thread."""
+    """Whether check(chain) becomes true: the emulator reads bytes in its own thread."""
     return until(lambda: server.call(check), seconds)
 
 

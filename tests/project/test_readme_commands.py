@@ -24,12 +24,13 @@ from helpers.readme import HARDWARE_PORTS, README, commands, prepare, promise, t
 @pytest.fixture(scope="module")
 def port():
     """A virtual C-863 on a pseudo-terminal: the README's /dev/ttyUSB0."""
+    from mercmac.emulator.chain import Chain
     from mercmac.emulator.ptyserver import PtyServer
     from mercmac.emulator.virtual import VirtualController
 
     # the commands' default timeouts on the line's clock: an answer is awaited however
     # loaded the machine, and the silent addresses of `scan` pass in milliseconds
-    with PtyServer(VirtualController("C-863", 0)) as server, line_clock(server):
+    with PtyServer(Chain([VirtualController("C-863", 0)])) as server, line_clock(server):
         yield server.path
 
 

@@ -71,12 +71,13 @@ main()
 def test_commands_run_where_lark_cannot_be_imported(args, tmp_path):
     """Each command as a process in which `import lark` fails; a syntax error too, which goes
     through the error recovery (parse.py: the stand-alone parser generated from grammar.lark)."""
+    from mercmac.emulator.chain import Chain
     from mercmac.emulator.ptyserver import PtyServer
     from mercmac.emulator.virtual import VirtualController
 
     (tmp_path / "bad.mcm").write_text("autostart {\n    MR 5 ]\n}\n", encoding="utf-8")
     env = {**os.environ, "PYTHONPATH": str(ROOT), "MERCMAC_DATA_DIR": str(tmp_path)}
-    with PtyServer(VirtualController("C-863", 0)) as server:
+    with PtyServer(Chain([VirtualController("C-863", 0)])) as server:
         args = [server.path if a == "PORT" else a for a in args]
         for words, code in ((args, 0), (["check", str(tmp_path / "bad.mcm")], 1)):
             done = subprocess.run([sys.executable, "-c", BLOCK_LARK, *words], cwd=ROOT, env=env,

@@ -36,7 +36,7 @@ from mercmac.emulator.chain import Chain
 from mercmac.emulator.ptyserver import PtyServer
 from mercmac.emulator.virtual import VirtualController
 from mercmac.upload import history
-from mercmac.upload.rig import flash_rig
+from mercmac.upload.chain import flash_chain
 
 SCENARIO = ROOT / "examples" / "scenarios" / "manual-example4-four-modes.mode2.toml"
 FORGED = "all controllers verified"
@@ -152,7 +152,7 @@ def _pull_file(tmp: Path, name: str) -> str:
 def _flashed_by_an_old_mercmac(server, tmp: Path, name: str) -> None:
     """The rig flashed, then its records changed as a file of the history may hold them:
     the rig's name is `name` (which `pull --rig` may take for its rig file, or leave)."""
-    flash_rig(server.path, str(_rig(tmp / "rig", "x")), timing=FAST_TIMING)
+    flash_chain(server.path, str(_rig(tmp / "rig", "x")), timing=FAST_TIMING)
     for path in history.folder().iterdir():
         record = json.loads(path.read_text(encoding="utf-8"))
         path.write_text(json.dumps({**record, "rig_name": name}), encoding="utf-8")

@@ -19,7 +19,7 @@ from mercmac.emulator.virtual import Faults, VirtualController
 from mercmac.upload import history
 from mercmac.upload.errors import FlashFailed, NotChosen, Refused
 from mercmac.upload.flasher import FlashOptions
-from mercmac.upload.rig import State, flash_rig
+from mercmac.upload.chain import State, flash_chain
 
 RASTER = ROOT / "examples" / "rigs" / "raster"
 
@@ -64,7 +64,7 @@ def md_counts(server, vcs) -> list[int]:
 
 def test_a_full_flash_writes_each_controller_at_its_address_macro_0_last(rig, data_dir):
     with chain() as (server, vcs, log):
-        result = flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        result = flash_chain(server.path, str(rig), timing=FAST_TIMING)
         held = [server.call(lambda _c, vc=vc: dict(vc.macros)) for vc in vcs]
     assert [p.state for p in result.parts] == [State.FLASHED, State.FLASHED]
     for part, macros in zip(result.parts, held):
@@ -79,9 +79,9 @@ def test_a_full_flash_writes_each_controller_at_its_address_macro_0_last(rig, da
 
 def test_an_unchanged_rig_writes_nothing(rig, data_dir):
     with chain() as (server, vcs, log):
-        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        flash_chain(server.path, str(rig), timing=FAST_TIMING)
         before = md_counts(server, vcs)
-        again = flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        again = flash_chain(server.path, str(rig), timing=FAST_TIMING)
         assert md_counts(server, vcs) == before
     assert again.changes_nothing
     assert [p.state for p in again.parts] == [State.UNCHANGED, State.UNCHANGED]
@@ -89,7 +89,7 @@ def test_an_unchanged_rig_writes_nothing(rig, data_dir):
 
 def test_only_flashes_the_named_controllers(rig, data_dir):
     with chain() as (server, vcs, log):
-        result = flash_rig(server.path, str(rig), only=["y"], timing=FAST_TIMING)
+        result = flash_chain(server.path, str(rig), only=["y"], timing=FAST_TIMING)
         counts = md_counts(server, vcs)
     assert counts[0] == 0 and counts[1] > 0
     assert [p.state for p in result.parts] == [State.LEFT_OUT, State.FLASHED]
@@ -98,13 +98,13 @@ def test_only_flashes_the_named_controllers(rig, data_dir):
 
 def test_only_with_a_name_the_rig_lacks_is_refused(rig, data_dir):
     with chain() as (server, vcs, log), pytest.raises(NotChosen, match="z"):
-        flash_rig(server.path, str(rig), only=["z"], timing=FAST_TIMING)
+        flash_chain(server.path, str(rig), only=["z"], timing=FAST_TIMING)
 
 
 def test_a_wrong_model_at_the_second_address_writes_nothing_and_says_so(rig, data_dir):
     with chain(models=("C-663", "C-863")) as (server, vcs, log), \
             pytest.raises(Refused) as stopped:
-        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        flash_chain(server.path, str(rig), timing=FAST_TIMING)
         assert md_counts(server, vcs) == [0, 0]
     text = stopped.value.message
     assert "C-863" in text and "y" in text
@@ -115,7 +115,7 @@ def test_a_failure_on_the_second_controller_says_what_each_holds(rig, data_dir):
     # every MD line for y's slot 1 loses a character: it never verifies
     with chain(faults=(None, Faults(always_drop_slot=1))) as (server, vcs, log), \
             pytest.raises(FlashFailed) as stopped:
-        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        flash_chain(server.path, str(rig), timing=FAST_TIMING)
     text = stopped.value.message
     assert "stopped at y (address 1)" in text
     assert "x (address 0): flashed and verified" in text
@@ -124,7 +124,7 @@ def test_a_failure_on_the_second_controller_says_what_each_holds(rig, data_dir):
 
 def test_history_records_the_rig_and_each_controller(rig, data_dir):
     with chain() as (server, vcs, log):
-        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        flash_chain(server.path, str(rig), timing=FAST_TIMING)
     found = sorted(history.records(), key=lambda r: r.address)
     assert [(r.address, r.controller, r.rig_name) for r in found] == [(0, "x", "raster"),
                                                                        (1, "y", "raster")]
@@ -133,9 +133,9 @@ def test_history_records_the_rig_and_each_controller(rig, data_dir):
 
 def test_backup_names_a_folder_or_a_prefix(rig, tmp_path, data_dir):
     with chain() as (server, vcs, log):
-        flash_rig(server.path, str(rig), timing=FAST_TIMING,
+        flash_chain(server.path, str(rig), timing=FAST_TIMING,
                   options=FlashOptions(backup=f"{tmp_path}/saved/"))
-        flash_rig(server.path, str(rig), timing=FAST_TIMING,
+        flash_chain(server.path, str(rig), timing=FAST_TIMING,
                   options=FlashOptions(backup=tmp_path / "before.mcm"))
     assert sorted(p.name for p in (tmp_path / "saved").iterdir()) == ["raster-x.mcm",
                                                                      "raster-y.mcm"]
@@ -213,7 +213,7 @@ def test_flash_rig_as_a_process_then_unchanged(rig, tmp_path, data_dir):
 
 def test_reset_starts_every_macro_0_once_all_are_verified(rig, data_dir):
     with chain() as (server, vcs, log):
-        flash_rig(server.path, str(rig), timing=FAST_TIMING, options=FlashOptions(reset=True))
+        flash_chain(server.path, str(rig), timing=FAST_TIMING, options=FlashOptions(reset=True))
         # the emulator reads the last RT in its own thread
         assert eventually(server, lambda _c: all(vc.running for vc in vcs))
     assert log.getvalue().count("52 54 0d") == 2  # 'RT<CR>', once to each (MS176E §6.4 RT)

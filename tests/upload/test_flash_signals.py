@@ -28,7 +28,7 @@ from mercmac.emulator.virtual import Faults, VirtualController
 from mercmac.errors import interrupt
 from mercmac.upload.errors import FlashInterrupted
 from mercmac.upload.flasher import Event, EventKind
-from mercmac.upload.rig import RigWatch, flash_rig
+from mercmac.upload.chain import Watch, flash_chain
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "openpty") or not hasattr(signal, "SIGHUP"),
                                 reason="needs pseudo-terminals and POSIX signals")
@@ -178,7 +178,7 @@ def test_a_terminal_that_hangs_up_while_flashing_gets_the_report_where_stderr_go
 
 # -- the library: a Signalled (SIGTERM, SIGHUP) wherever a KeyboardInterrupt is answered --------
 
-class SignalledAt(RigWatch):
+class SignalledAt(Watch):
     """A rig flash's watch whose notify raises what SIGNUM raises in a command (mercmac.errors
     .interrupt) at the first event of KIND, while meeting the controllers or writing them."""
 
@@ -204,7 +204,7 @@ def test_a_signal_while_a_rig_is_backed_up_writes_nothing_and_exits_128_plus_n(s
     vcs = [VirtualController("C-663", address) for address in (0, 1)]
     with PtyServer(Chain(vcs), io.StringIO()) as server, \
             pytest.raises(FlashInterrupted) as caught:
-        flash_rig(server.path, str(rig), timing=FAST_TIMING,
+        flash_chain(server.path, str(rig), timing=FAST_TIMING,
                   watch=SignalledAt(EventKind.BACKUP, signum))
     assert caught.value.exit_code == 128 + signum
     assert caught.value.message.startswith("x: interrupted before the first write; nothing was "
@@ -219,7 +219,7 @@ def test_a_signal_while_a_rig_is_written_names_the_signal_and_exits_128_plus_n(s
     vcs = [VirtualController("C-663", address) for address in (0, 1)]
     with PtyServer(Chain(vcs), io.StringIO()) as server, \
             pytest.raises(FlashInterrupted) as caught:
-        flash_rig(server.path, str(rig), timing=FAST_TIMING,
+        flash_chain(server.path, str(rig), timing=FAST_TIMING,
                   watch=SignalledAt(EventKind.VERIFIED, signum))
     how = "Ctrl-C" if signum == signal.SIGINT else signal.Signals(signum).name
     assert caught.value.exit_code == 128 + signum

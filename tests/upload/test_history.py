@@ -51,7 +51,7 @@ def test_flash_then_pull_gives_back_the_source(tmp_path, data_dir, program):
 def test_a_changed_controller_is_not_taken_for_the_recorded_build(tmp_path, data_dir, program):
     with _serve() as (server, vc):
         assert cli("flash", server.path, program, "--backup", tmp_path / "b.mcm", *FAST).exit_code == 0
-        server.call(lambda c: c._define("MD15,MR5"))
+        server.call(lambda _c: vc._define("MD15,MR5"))
         pulled = cli("pull", server.path, *FAST)
     assert pulled.exit_code == 0, pulled.output
     assert "[MC15] MR5" in pulled.stdout and "holds four-modes.mcm" not in pulled.output

@@ -63,7 +63,7 @@ def test_one_macro_is_one_macro_in_pull_and_in_the_flash_backup(tmp_path):
     assert pulled.exit_code == 0 and "read 2 macros from" in pulled.output
     with serve(macros={3: "MR5"}) as (server, vc):
         one = cli("pull", server.path, "-o", tmp_path / "one.mcm", *FAST)
-        server.call(lambda c: c._define("MD7,MR7"))
+        server.call(lambda _c: vc._define("MD7,MR7"))
         restored = cli("flash", server.path, tmp_path / "one.mcm", "--backup", tmp_path / "c.mcm",
                        *FAST)
     assert one.exit_code == 0 and "read 1 macro from" in one.output, one.output

@@ -310,7 +310,7 @@ def test_a_second_ctrl_c_exits_cleanly_with_the_same_message(gap, program_file, 
                                  str(program_file), "--backup", str(backup), *FAST],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
         end = time.monotonic() + 10
-        while server.call(lambda v: v.md_count) < 1 and time.monotonic() < end:
+        while server.call(lambda _c: vc.md_count) < 1 and time.monotonic() < end:
             time.sleep(0.005)
         proc.send_signal(signal.SIGINT)
         time.sleep(gap)

@@ -251,7 +251,7 @@ def test_restoring_a_backup_says_it_needs_erase_unused(tmp_path):
     with serve(macros={0: "EM1", 3: "TP"}) as (server, vc):
         saved = cli("pull", server.path, "-o", tmp_path / "saved.mcm", *SEARCH_TIMEOUT)
         assert saved.exit_code == 0, saved.output
-        server.call(lambda v: v._store({**v.macros, 7: "TT", 8: "TP"}))  # the controller gains two
+        server.call(lambda _c: vc._store({**vc.macros, 7: "TT", 8: "TP"}))  # the controller gains two
         kept = cli("flash", server.path, tmp_path / "saved.mcm", "--backup", tmp_path / "b1.mcm", *SEARCH_TIMEOUT)
         assert kept.exit_code == 0, kept.output
         assert "this backup holds 2 macros; the controller also holds MC07, MC08" in kept.output

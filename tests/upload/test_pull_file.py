@@ -1,5 +1,5 @@
 """upload.survey.pull_file: the controller half of `mercmac pull` and `decompile --port`,
-finding the address as flash_file does. The virtual controller on a real pty."""
+finding the address as a flash does (upload.chain). The virtual controller on a real pty."""
 from __future__ import annotations
 
 import pytest
@@ -7,7 +7,8 @@ import pytest
 from contextlib import contextmanager
 
 from mercmac.upload import survey
-from mercmac.upload.flasher import FlashOptions, Watch, flash_file
+from mercmac.upload.chain import Watch, flash_chain
+from mercmac.upload.flasher import FlashOptions
 from helpers.emulator import FAST_TIMING, serve_clocked as serve  # searches: on the line's clock
 
 
@@ -52,8 +53,9 @@ def test_flash_and_pull_find_the_same_address(tmp_path):
         searching = staticmethod(flashed)
 
     with serve(address=9) as (server, vc):
-        result = flash_file(server.path, str(program), address=None, timing=FAST_TIMING,
-                            options=FlashOptions(backup=tmp_path / "b.mcm"), watch=Shown())
+        result = flash_chain(server.path, str(program), address=None, timing=FAST_TIMING,
+                             options=FlashOptions(backup=tmp_path / "b.mcm"),
+                             watch=Shown()).parts[0].result
         back = survey.pull_file(server.path, address=None, timing=FAST_TIMING, searching=pulled)
     assert result.identity.address == back.identity.address == 9
     assert flashed.probed == pulled.probed == list(range(1, 16))

@@ -16,7 +16,7 @@ from mercmac.emulator.chain import Chain
 from mercmac.emulator.ptyserver import PtyServer
 from mercmac.emulator.virtual import VirtualController
 from mercmac.rig.load import read_rig
-from mercmac.upload.rig import flash_rig
+from mercmac.upload.chain import flash_chain
 
 RASTER = ROOT / "examples" / "rigs" / "raster"
 # what a controller mercmac never flashed may hold: MMCRun's raw lines (MS176E §3.8.6)
@@ -44,11 +44,11 @@ def held(server, vcs) -> list[dict[int, str]]:
 def test_pull_rig_gives_back_the_flashed_rig_and_it_round_trips(rig, tmp_path, data_dir):
     out = tmp_path / "pulled"
     with chain() as (server, vcs):
-        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        flash_chain(server.path, str(rig), timing=FAST_TIMING)
         result = cli("pull", server.path, "--rig", out, *FAST)
         assert result.exit_code == 0, result.output
         before = [server.call(lambda _c, vc=vc: vc.md_count) for vc in vcs]
-        again = flash_rig(server.path, str(out / "raster.rig.toml"), timing=FAST_TIMING)
+        again = flash_chain(server.path, str(out / "raster.rig.toml"), timing=FAST_TIMING)
         assert [server.call(lambda _c, vc=vc: vc.md_count) for vc in vcs] == before
     assert again.changes_nothing
     assert sorted(p.name for p in out.iterdir()) == ["raster.rig.toml", "x.mcm", "y.mcm"]
@@ -94,7 +94,7 @@ def test_rig_with_options_that_do_not_go_with_it_is_refused(tmp_path):
 def test_pull_rig_as_a_process(rig, tmp_path, data_dir):
     out = tmp_path / "pulled"
     with chain() as (server, vcs):
-        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        flash_chain(server.path, str(rig), timing=FAST_TIMING)
         done = mercmac_process("pull", server.path, "--rig", str(out), *SEARCHING, cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert "recorded source" in done.stderr
@@ -118,7 +118,7 @@ def test_a_poisoned_history_never_leads_out_of_the_folder(rig, tmp_path, data_di
     """Item 1: the rig's name in the history became DIR/NAME.rig.toml, '../../x' included."""
     out = tmp_path / "deep" / "er" / "pulled"
     with chain() as (server, vcs):
-        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        flash_chain(server.path, str(rig), timing=FAST_TIMING)
         _poison(data_dir, name, name)
         result = cli("pull", server.path, "--rig", out, *FAST)
     assert result.exit_code == 0, result.output
@@ -150,7 +150,7 @@ def test_pulling_into_the_rigs_own_folder_needs_force(rig, data_dir, command):
     (folder / "x.mcm").write_text((folder / "x.mcm").read_text() + "// edited, not flashed\n")
     before = _files(folder)
     with chain() as (server, vcs):
-        flash_rig(server.path, str(rig), timing=FAST_TIMING)
+        flash_chain(server.path, str(rig), timing=FAST_TIMING)
         (folder / "x.mcm").write_text(before["x.mcm"] + "// edited again\n")
         before = _files(folder)
         args = [a.format(port=server.path) for a in command]
@@ -258,7 +258,7 @@ def test_a_history_name_like_another_address_does_not_merge_two_controllers(tmp_
     rig = write_rig(tmp_path, toml)
     out = tmp_path / "bench"
     with chain(({}, RAW[1])) as (server, vcs):
-        flash_rig(server.path, str(rig), only=["a1"], timing=FAST_TIMING)
+        flash_chain(server.path, str(rig), only=["a1"], timing=FAST_TIMING)
         result = cli("pull", server.path, "--rig", out, *FAST)
     assert result.exit_code == 0, result.output
     assert sorted(p.name for p in out.iterdir()) == ["a1.mcm", "a1_.mcm", "r.rig.toml"]

@@ -133,7 +133,7 @@ def test_scan_lists_who_answers(tmp_path):
 def test_scan_leaves_a_running_macro_alone(tmp_path):
     with serve(address=4, macros={0: "SC4,WA10,RP"}) as (server, vc), line_clock(server):
         result = cli("scan", server.path, *FAST)
-        assert server.call(lambda v: v.running)
+        assert server.call(lambda _c: vc.running)
     assert "macro running, left alone" in result.output
 
 
@@ -182,7 +182,7 @@ def test_ctrl_c_in_a_real_process(tmp_path, program_file):
                                              str(tmp_path / "b.mcm"), *FAST),
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         end = time.monotonic() + 10
-        while server.call(lambda v: v.md_count) < 1 and time.monotonic() < end:
+        while server.call(lambda _c: vc.md_count) < 1 and time.monotonic() < end:
             time.sleep(0.005)
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=10)

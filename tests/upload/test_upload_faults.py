@@ -159,7 +159,7 @@ def test_ctrl_c_mid_flash(tmp_path):
     with serve(macros={0: "EM5", 5: "GH"}, faults=Faults(md_delay=0.05)) as (server, vc):
         def interrupt_after_two_writes():
             # never after the test: a late SIGINT would stop whichever test runs then
-            while not over.is_set() and server.call(lambda v: v.md_count) < 2:
+            while not over.is_set() and server.call(lambda _c: vc.md_count) < 2:
                 time.sleep(0.002)
             if not over.is_set():
                 signal.pthread_kill(main, signal.SIGINT)  # a real SIGINT, as Ctrl-C sends
@@ -182,7 +182,7 @@ def test_ctrl_c_mid_flash(tmp_path):
 def test_a_controller_that_falls_silent_after_identifying_is_refused_before_writing(tmp_path):
     with serve_clocked() as (server, vc), connect(server) as c:
         who = identify(c)
-        server.call(lambda v: setattr(v.faults, "silent", True))
+        server.call(lambda _c: setattr(vc.faults, "silent", True))
         with pytest.raises(Refused) as caught:
             flash(c, who, program_of(PROGRAM), FlashOptions(backup=tmp_path / "b.mcm"))
         assert "no answer to TM" in caught.value.message

@@ -99,8 +99,8 @@ def test_addresses_a_to_f(tmp_path, address):
 def test_reset_starts_macro_0(tmp_path):
     with serve() as (server, vc):
         run_flash(server, program_of("[MC00] WA5000\n"), tmp_path, reset=True)
-        assert eventually(server, lambda v: v.lines[-1] == "RT")
-        assert server.call(lambda v: v.running)  # macro 0 runs after RT (MS176E §6.4 RT)
+        assert eventually(server, lambda _c: vc.lines[-1] == "RT")
+        assert server.call(lambda _c: vc.running)  # macro 0 runs after RT (MS176E §6.4 RT)
 
 
 def test_byte_goals_of_the_benchmark(capsys):

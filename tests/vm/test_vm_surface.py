@@ -13,7 +13,7 @@ from mercmac.compiler.program import Macro
 from mercmac.ops import Op, Origin, Role
 from mercmac.emulator.virtual import VirtualController
 from mercmac.source import Source
-from mercmac.upload import flasher
+from mercmac.upload import chain, flasher
 from mercmac.upload.errors import Refused
 from mercmac.vm import Machine, Options
 from mercmac.vm import reports
@@ -200,17 +200,17 @@ def test_flash_file_compiles_for_the_model_that_answers(tmp_path):
     source.write_text("[MC03] MR200\n")
     seen = []
 
-    class Watch(flasher.Watch):
-        def identified(self, identity, warning):
-            seen.append((identity.version.model, warning))
+    class Watch(chain.Watch):
+        def identified(self, part, warning):
+            seen.append((part.identity.version.model, warning))
 
         def finished(self, result):
             seen.append("finished")
 
     with serve(macros={7: "TP"}) as (server, vc):
-        result = flasher.flash_file(server.path, str(source), timing=FAST_TIMING,
-                                    options=flasher.FlashOptions(backup=tmp_path / "b.mcm"),
-                                    watch=Watch())
+        result = chain.flash_chain(server.path, str(source), timing=FAST_TIMING,
+                                   options=flasher.FlashOptions(backup=tmp_path / "b.mcm"),
+                                   watch=Watch()).parts[0].result
         assert vc.macros == {3: "MR200", 7: "TP"}
     assert seen == [("C-863", None), "finished"] and result.backup == tmp_path / "b.mcm"
 
@@ -220,13 +220,13 @@ def test_flash_file_refuses_a_file_with_errors_for_the_model_that_answers(tmp_pa
     source.write_text("[MC03] DC100\n")  # DC is a C-663 command
     refused = []
 
-    class Watch(flasher.Watch):
-        def refused(self, compilation):
-            refused.append(compilation.report.has_errors)
+    class Watch(chain.Watch):
+        def refused(self, findings):
+            refused.append(findings[0].compilation.report.has_errors)
 
     with serve() as (server, vc):
         with pytest.raises(Refused, match="has errors for the C-863; nothing was flashed"):
-            flasher.flash_file(server.path, str(source), timing=FAST_TIMING, watch=Watch())
+            chain.flash_chain(server.path, str(source), timing=FAST_TIMING, watch=Watch())
         assert vc.md_count == 0
     assert refused == [True]
 
@@ -236,7 +236,8 @@ def test_flash_file_of_a_program_for_another_model(tmp_path):
     source.write_text("target C-663\n[MC03] MR200\n")
     with serve() as (server, vc):
         with pytest.raises(Refused, match="targets the C-663"):
-            flasher.flash_file(server.path, str(source), timing=FAST_TIMING)
-        result = flasher.flash_file(server.path, str(source), timing=FAST_TIMING, force=True,
-                                    options=flasher.FlashOptions(backup=tmp_path / "b.mcm"))
+            chain.flash_chain(server.path, str(source), timing=FAST_TIMING)
+        result = chain.flash_chain(server.path, str(source), timing=FAST_TIMING, force=True,
+                                   options=flasher.FlashOptions(backup=tmp_path / "b.mcm"))
+        result = result.parts[0].result
         assert vc.macros == {3: "MR200"} and result.identity.version.model == "C-863"
