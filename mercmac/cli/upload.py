@@ -324,9 +324,18 @@ def pull_rig(port: str, folder: Path, baud: int, timeout: float, text_of, *,
                          f"written", hint="--force replaces them (your edits in them are lost)") \
             from None
     rig_file = folder / f"{name}.rig.toml"
-    write_lines(view.pulled_rig_lines(members, port, rig_file, [how for _, how in made]),
-                sys.stderr)
+    write_lines(view.pulled_rig_lines(members, port, rig_file, [how for _, how in made],
+                                      _checked(rig_file)), sys.stderr)
     return EXIT_OK
+
+
+def _checked(rig_file: Path) -> list:
+    """What `check` finds in the rig just written, read back as every command reads a rig
+    (rig.open): its diagnostics, so that the table says whether the folder checks clean (a
+    controller whose VE names no model mercmac knows has none in the rig file)."""
+    from mercmac.rig.open import open_rig
+
+    return [d for found in open_rig(str(rig_file)).findings for d in found.diagnostics]
 
 
 def _listed(paths: list[Path]) -> str:

@@ -466,12 +466,27 @@ def _rig_style(row) -> str:
     return "bold green" if row[4].startswith("flashed") else "dim" if row[4] == "unchanged" else ""
 
 
-def pulled_rig_lines(members, port: str, rig_file, how: list[str]) -> list[Line]:
-    """A row per controller read from the chain, what its file holds (`how`), the rig file."""
+def pulled_rig_lines(members, port: str, rig_file, how: list[str],
+                     found: list) -> list[Line]:
+    """A row per controller read from the chain, what its file holds (`how`), the rig file,
+    and what `check` finds in it as written (`found`: its diagnostics)."""
     rows = [(m.name, str(m.address), m.pulled.identity.version.name,
              plural(len(m.pulled.macros), "macro"), made) for m, made in zip(members, how)]
     lines = table(("controller", "address", "model", "holds", "written as"), rows)
     lines.append([("rig: ", "bold"), (f"{printable(str(rig_file))} ("
                                       f"{plural(len(members), 'controller')} on "
                                       f"{printable(port)}; wires cannot be read: add them)", "")])
-    return lines
+    return lines + [_checked_line(rig_file, found)]
+
+
+def _checked_line(rig_file, found: list) -> Line:
+    """'check: clean', or what `mercmac check RIG` will say of the folder as written."""
+    from mercmac.diagnostics import Severity
+
+    counts = [sum(d.severity is s for d in found) for s in Severity]
+    said = ", ".join(plural(n, str(s)) for n, s in zip(counts, Severity) if n)
+    where = f"; `mercmac check {printable(str(rig_file))}` lists them"
+    if not counts[Severity.ERROR] and not counts[Severity.WARNING]:
+        return [("check: ", "bold"), ("clean", "green"), (f" ({said}{where})" if said else "", "")]
+    return [("check: ", "bold"), (said, "bold red" if counts[Severity.ERROR] else "yellow"),
+            (where, "")]

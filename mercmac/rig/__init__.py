@@ -36,7 +36,7 @@ Drawing:
     mercmac/decompile/rig.py       what the wires carry, and a call graph with a cluster each
 Hardware:
     mercmac/emulator/chain.py      a virtual daisy chain on one pty (`emulate --rig`)
-    mercmac/upload/rig.py          flashing every controller of a chain; pulling a chain
+    mercmac/upload/rig.py          a rig's backup paths; pulling a chain into a rig folder
 Editor:
     mercmac/lsp/rig.py             rig files and the programs a rig names, in the editor
 """

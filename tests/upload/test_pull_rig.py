@@ -292,3 +292,25 @@ def test_a_given_timeout_is_the_wait_at_each_address_searched(tmp_path, monkeypa
         result = cli(command[0], server.path, *command[1:], *given)
     assert result.exit_code == 0, result.output
     assert waits == [search]
+
+
+def test_pull_rig_says_whether_the_folder_it_wrote_checks(tmp_path, data_dir):
+    """The rig written is read back as every command reads a rig (rig.open): its check."""
+    from mercmac.emulator.faults import Faults
+
+    with chain(({0: "SV20000,CP3"}, {0: "MR500,WS10,CN2"})) as (server, vcs):
+        clean = cli("pull", server.path, "--rig", tmp_path / "clean", *FAST)
+    with chain(RAW) as (server, vcs):  # each waits on an input no wire drives yet: MR011
+        waits = cli("pull", server.path, "--rig", tmp_path / "waits", *FAST)
+    unknown = [VirtualController("C-663", 0, macros=dict(RAW[0])),
+               VirtualController("C-663", 1, macros=dict(RAW[1]),
+                                 faults=Faults(version="(c)2026 a controller Ver. 9.99"))]
+    with PtyServer(Chain(unknown)) as server, line_clock(server):
+        said = cli("pull", server.path, "--rig", tmp_path / "unknown", *FAST)
+    assert clean.exit_code == 0 and "check: clean" in clean.output
+    assert cli("check", tmp_path / "clean" / "clean.rig.toml").exit_code == 0
+    assert waits.exit_code == 0 and "check: 2 warnings, 2 infos; `mercmac check" in waits.output
+    assert said.exit_code == 0, said.output
+    line = next(line for line in said.output.splitlines() if line.startswith("check: "))
+    assert line.startswith("check: 1 error") and "unknown.rig.toml` lists them" in line
+    assert cli("check", tmp_path / "unknown" / "unknown.rig.toml").exit_code == 1
