@@ -5,7 +5,8 @@ from __future__ import annotations
 
 HEADINGS = {
     "architecture.md": ["The floors", "One way down", "One table, one model, one renderer",
-                        "A program is a rig of one", "Where rigs live"],
+                        "A program is a rig of one", "Where rigs live",
+                        "Changing the code without changing what it shows"],
     "language.md": ["Programs and macros", "Statements", "Lowering", "Targets and settings"],
     "checks.md": ["How check reads a file", "Rules", "Fixes"],
     "simulator.md": ["Time", "Calls and the return point", "Repeat counters", "Conditions",
