@@ -141,12 +141,12 @@ def random_rig(rnd: random.Random, folder: Path) -> Path:
 
 
 class Dumper:
-    def __init__(self, out: Path):
+    def __init__(self, out: Path, work: Path):
         from click.testing import CliRunner
 
         from mercmac.cli import main
 
-        self.out, self.main, self.runner = out, main, CliRunner()
+        self.out, self.work, self.main, self.runner = out, str(work), main, CliRunner()
         self.plotted = 0
 
     def cli(self, name: str, args: list[str], stdin: str | None = None) -> None:
@@ -154,8 +154,8 @@ class Dumper:
         text = result.output
         if result.exception is not None and not isinstance(result.exception, SystemExit):
             text += f"\n!! {type(result.exception).__name__}: {result.exception}\n"
-        (self.out / f"{name}.txt").write_text(f"exit {result.exit_code}\n{text}",
-                                              encoding="utf-8")
+        text = f"exit {result.exit_code}\n{text}".replace(self.work, "<work>")
+        (self.out / f"{name}.txt").write_text(text, encoding="utf-8")
 
     def sim(self, name: str, file: str, args: list[str], *, plot: bool = False,
             views: bool = True) -> None:
@@ -179,7 +179,7 @@ class Dumper:
         if not os.path.exists(f"out.{kind}"):
             return
         if kind in ("svg", "html"):  # matplotlib's clip-path ids differ from run to run
-            text = Path(f"out.{kind}").read_text(encoding="utf-8")
+            text = Path(f"out.{kind}").read_text(encoding="utf-8").replace(self.work, "<work>")
             Path(f"out.{kind}").write_text(re.sub(r"\bp[0-9a-f]{10}\b", "pID", text),
                                           encoding="utf-8")
         os.replace(f"out.{kind}", self.out / name)
@@ -193,17 +193,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("out", type=Path)
     parser.add_argument("--quick", action="store_true", help="a smaller corpus")
-    parser.add_argument("--work", type=Path, default=Path(tempfile.gettempdir()) / "mercmac-dumps",
-                        help="where the corpus's files are written (the same for both runs)")
+    parser.add_argument("--work", type=Path, default=None,
+                        help="where the corpus's files are written (default: a new temporary "
+                             "folder; its path shows as <work> in the outputs)")
     args = parser.parse_args()
     out: Path = args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)
-    # the programs are written to one folder whatever OUT is: their paths show in outputs
-    work = args.work.resolve()
+    # the programs' paths show in outputs: written as <work>, two runs compare wherever they ran
+    work = (args.work or Path(tempfile.mkdtemp(prefix="mercmac-dumps-"))).resolve()
     work.mkdir(parents=True, exist_ok=True)
     os.chdir(work)
     os.environ.setdefault("COLUMNS", "120")
-    d = Dumper(out)
+    d = Dumper(out, work)
     rnd = random.Random(2711)
     examples = work / "examples"  # the bundled ones, copied: their paths show in messages
     shutil.rmtree(examples, ignore_errors=True)

@@ -302,13 +302,13 @@ def emulated(c: Cases) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("out", type=Path)
-    parser.add_argument("--work", type=Path,
-                        default=Path(tempfile.gettempdir()) / "mercmac-flash-dumps",
-                        help="where the cases' files are written (the same for both runs)")
+    parser.add_argument("--work", type=Path, default=None,
+                        help="where the cases' files are written (default: a new temporary "
+                             "folder; its path shows as <work> in the outputs)")
     args = parser.parse_args()
     out = args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)
-    work = args.work.resolve()
+    work = (args.work or Path(tempfile.mkdtemp(prefix="mercmac-flash-dumps-"))).resolve()
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
     c = Cases(out, work)
