@@ -329,13 +329,18 @@ def pull_rig(port: str, folder: Path, baud: int, timeout: float, text_of, *,
     return EXIT_OK
 
 
-def _checked(rig_file: Path) -> list:
+def _checked(rig_file: Path) -> list | str:
     """What `check` finds in the rig just written, read back as every command reads a rig
     (rig.open): its diagnostics, so that the table says whether the folder checks clean (a
-    controller whose VE names no model mercmac knows has none in the rig file)."""
+    controller whose VE names no model mercmac knows has none in the rig file); or why it
+    could not be checked (a settings file above the folder that `check` refuses): the pull
+    itself is done."""
     from mercmac.rig.open import open_rig
 
-    return [d for found in open_rig(str(rig_file)).findings for d in found.diagnostics]
+    try:
+        return [d for found in open_rig(str(rig_file)).findings for d in found.diagnostics]
+    except MercmacError as e:
+        return e.message
 
 
 def _listed(paths: list[Path]) -> str:

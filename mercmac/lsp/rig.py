@@ -49,7 +49,7 @@ def rig_diagnostics(source: Source, choice: Choice) -> list[Diagnostic]:
     its path), under `choice`: its own findings, and those of a program that is the rig file
     (the programs' own belong to their files). Where `check` cannot read the rig (too large,
     a failure reading it or a program), one diagnostic at 1:1 says why: never a clean rig."""
-    from mercmac.rig.open import RigUnreadable, open_rig
+    from mercmac.rig.open import open_rig
 
     here = os.path.realpath(source.name)
 
@@ -58,8 +58,6 @@ def rig_diagnostics(source: Source, choice: Choice) -> list[Diagnostic]:
 
     try:
         found = open_rig(source.name, text=source.text, read=read).checked(choice)
-    except RigUnreadable as e:  # `check`'s words for a file it cannot read
-        return [_unchecked(source, e)]
     except Exception as e:  # what stops `check` (or a bug) is said where the editor shows it
         return [_unchecked(source, e)]
     return [d for f in found if os.path.realpath(f.compilation.source.name) == here

@@ -467,9 +467,10 @@ def _rig_style(row) -> str:
 
 
 def pulled_rig_lines(members, port: str, rig_file, how: list[str],
-                     found: list) -> list[Line]:
+                     found: list | str) -> list[Line]:
     """A row per controller read from the chain, what its file holds (`how`), the rig file,
-    and what `check` finds in it as written (`found`: its diagnostics)."""
+    and what `check` finds in it as written (`found`: its diagnostics, or why it could not
+    check it)."""
     rows = [(m.name, str(m.address), m.pulled.identity.version.name,
              plural(len(m.pulled.macros), "macro"), made) for m, made in zip(members, how)]
     lines = table(("controller", "address", "model", "holds", "written as"), rows)
@@ -483,6 +484,8 @@ def _checked_line(rig_file, found: list) -> Line:
     """'check: clean', or what `mercmac check RIG` will say of the folder as written."""
     from mercmac.diagnostics import Severity
 
+    if isinstance(found, str):
+        return [("check: ", "bold"), (f"not run: {printable(found)}", "yellow")]
     counts = [sum(d.severity is s for d in found) for s in Severity]
     said = ", ".join(plural(n, str(s)) for n, s in zip(counts, Severity) if n)
     where = f"; `mercmac check {printable(str(rig_file))}` lists them"

@@ -141,10 +141,10 @@ def accept(path: str, chosen: checking.Options = checking.Options()) -> Accepted
     return open_rig(path, chosen).accepted()
 
 
-def open_program(path: str, *, target: str | None = None, address: int = 0) -> Accepted:
+def open_program(path: str, *, target: str | None = None) -> Accepted:
     """A lone program as a rig of one controller (docs/rigs.md, "A program is a rig of
-    one"): compiled for `target` (else its own `target` line), at `address`, with the box and
-    the joystick on it. RigRefused with its findings when it has errors; InputError (exit 2)
+    one"): compiled for `target` (else its own `target` line), with the box and the
+    joystick on it. RigRefused with its findings when it has errors; InputError (exit 2)
     when it cannot be read."""
     from mercmac.compiler import compile_file
 
@@ -152,15 +152,15 @@ def open_program(path: str, *, target: str | None = None, address: int = 0) -> A
     findings = [Findings(compiled, list(compiled.report.items))]
     if not _runs(compiled):
         raise RigRefused(path, findings)
-    rig = Rig.of_program(path, target or compiled.program.target, address)
+    rig = Rig.of_program(path, target or compiled.program.target)
     return Accepted(rig, {rig.controllers[0].name: compiled}, findings)
 
 
-def open_any(path: str, *, target: str | None = None, address: int = 0) -> Accepted:
+def open_any(path: str, *, target: str | None = None) -> Accepted:
     """A rig file accepted, or a lone program as a rig of one (open_program)."""
     if is_rig_path(path):
         return accept(path)
-    return open_program(path, target=target, address=address)
+    return open_program(path, target=target)
 
 
 def _errors(findings: list[Findings]) -> bool:

@@ -297,7 +297,7 @@ def run(sim: Simulation, plan: Scenario, until_ms: int) -> int:
     the rig's one clock); the number checked. In a rig of several, a step or an expectation
     is about the controller it names (`controller = "y"`), else the box's (or the only one):
     a step presses only what a person can (rig.presses)."""
-    default = _default(sim, plan)
+    default = _default(sim)
     parts = {name: _part(sim, plan, name, default) for name in sim.machines}
     _refuse_unknown_names(sim, plan, default)
     _refuse_unpressable(sim, plan, default)
@@ -313,7 +313,7 @@ def run(sim: Simulation, plan: Scenario, until_ms: int) -> int:
     return len(expects)
 
 
-def _default(sim: Simulation, plan: Scenario) -> str | None:
+def _default(sim: Simulation) -> str | None:
     """Who a step or expectation without `controller` is about: the box's controller, or
     the only one."""
     if sim.rig.box is not None:

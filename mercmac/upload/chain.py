@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterator
 
 from mercmac import mdtext
-from mercmac.compiler import Compilation, compile_file
+from mercmac.compiler import Compilation
 from mercmac.upload import backup, flasher, history, protocol, survey
 from mercmac.upload.connect import Identity, check_model, identify, open_controller
 from mercmac.upload.controller import Controller, ControllerError
@@ -307,14 +307,16 @@ def _rig_parts(accepted: "Accepted", only: list[str] | None, watch: Watch) -> li
 
 
 def _compile(path: str, target: str | None, watch: Watch) -> Compilation:
-    """PATH compiled for `target`; Refused (after `watch.refused`) if it has errors."""
-    from mercmac.compiler.checking import Findings
+    """PATH compiled for `target`, opened as every command opens a lone program
+    (rig.open.open_program); Refused (after `watch.refused`) if it has errors."""
+    from mercmac.rig.open import RigRefused, open_program
 
-    compilation = compile_file(path, target=target)
-    if compilation.report.has_errors or compilation.program is None:
-        watch.refused([Findings(compilation, list(compilation.report.items))])
+    try:
+        (compilation,) = open_program(path, target=target).programs.values()
+    except RigRefused as e:
+        watch.refused(e.findings)
         against = f" for the {target}" if target else ""
-        raise Refused(f"{path} has errors{against}; nothing was flashed")
+        raise Refused(f"{path} has errors{against}; nothing was flashed") from None
     return compilation
 
 

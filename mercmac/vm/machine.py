@@ -890,8 +890,8 @@ class Machine:
 
     def tell(self, event: object) -> None:
         """Have the listeners hear `event`. From outside (a rig's skip or dead-lock,
-        sim/rig_skip.py, sim/rig_deadlock.py)
-        the optimiser does not log it: it is no effect of one of this machine's passes."""
+        sim/rig_skip.py, sim/rig_deadlock.py) the optimiser does not log it: it is no effect
+        of one of this machine's passes."""
         for listener in self.listeners:
             listener(event)
 

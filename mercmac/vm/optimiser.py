@@ -325,7 +325,7 @@ class Optimiser:
                 and self.mode is FastForward.ALL):
             delta = position - previous.position
             moved = shapes.moved_shape(self.log[previous.logged - self.log_base:],
-                                   previous.wake, previous.position)
+                                       previous.wake, previous.position)
         return Visit(key, self.machine.wake, self.inputs, self.waits,
                      self.logged(), pass_shape, skey, position, delta, moved,
                      self.machine.clock.now, fresh, self.flows)

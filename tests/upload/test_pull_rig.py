@@ -314,3 +314,16 @@ def test_pull_rig_says_whether_the_folder_it_wrote_checks(tmp_path, data_dir):
     line = next(line for line in said.output.splitlines() if line.startswith("check: "))
     assert line.startswith("check: 1 error") and "unknown.rig.toml` lists them" in line
     assert cli("check", tmp_path / "unknown" / "unknown.rig.toml").exit_code == 1
+
+
+def test_pull_rig_that_check_cannot_run_on_is_pulled_and_says_why(tmp_path, data_dir):
+    """A settings file above the folder that `check` refuses: the pull is done (exit 0, every
+    file written), and its last line says why the rig was not checked."""
+    (tmp_path / "mercmac.toml").write_text('select = ["no-such-rule"]\n', encoding="utf-8")
+    with chain(({0: "SV20000,CP3"}, {0: "MR500,WS10,CN2"})) as (server, vcs):
+        said = cli("pull", server.path, "--rig", tmp_path / "bench", *FAST)
+    assert said.exit_code == 0, said.output
+    assert sorted(p.name for p in (tmp_path / "bench").iterdir()) == [
+        "a0.mcm", "a1.mcm", "bench.rig.toml"]
+    line = said.output.splitlines()[-1]
+    assert line.startswith("check: not run: ") and "no-such-rule" in line
