@@ -1,12 +1,14 @@
-"""Rigs of many controllers, run to their end: wall time and peak memory.
+"""Rigs of many controllers, and a stage chasing its target, run to their end: wall time and
+peak memory.
 
     python benchmarks/rig_speed.py [--give-up SECONDS]
 
 Each case is `mercmac sim RIG --until T --format json` in a fresh interpreter (start-up
 included, as sim_speed.py measures), given up after GIVE_UP seconds ("over"); its peak memory
 is the child's maximum resident set (os.wait4). A run's memory is bounded by its programs and
-its listing caps, not by how long it runs. Goals (docs/simulator.md, "Fast-forward"): every
-case at most 2 s of wall time and 150 MB.
+its listing caps (10,000 reports, LED changes and events per controller), not by how long it
+runs. Goals (docs/simulator.md, "Fast-forward"): every case at most 2 s of wall time; (d), (e)
+and (f) at most 150 MB (sixteen controllers list sixteen times as much).
 
 (a) 16 controllers, unwired, each `macro spin { CN 1, CF 1, TP x i, goto spin }` (i = 0-15):
     loops of 16 lengths, which a rig skips only when each controller skips on its own;
@@ -15,7 +17,10 @@ case at most 2 s of wall time and 150 MB.
     between the two of each pair): 1 h;
 (c) the raster example (examples/rigs/raster/) and 14 unwired busy controllers: 1 h;
 (d) three C-863/C-663 controllers in a token ring of raw macros (w3): to 3600 s;
-(e) two controllers, one driving the other's input, each looping RP3000 (slow): to 3600 s.
+(e) two controllers, one driving the other's input, each looping RP3000 (slow): to 3600 s;
+(f) `macro chase { MR 500, TT, MR 25000, CN 1, WA 5, CF 1, goto chase }`, a program (a rig of
+    one) on the C-863 and the C-663: the target runs ahead to the soft limit, then the stage
+    cruises to it, each pass commanding the move it is on again; 1 h and 1500 d.
 """
 from __future__ import annotations
 
@@ -73,6 +78,19 @@ def write_rig(folder: Path, programs: dict[str, tuple[int, str, str]], wires: li
     return path
 
 
+CHASE = ("target {model}\nmacro chase {{\n  MR 500, TT, MR 25000, CN 1, WA 5, CF 1, goto chase\n}}\n"
+         "autostart {{ goto chase }}\n")
+
+
+def chase(model: str):
+    """The chase loop as a program file on `model`."""
+    def make(folder: Path) -> Path:
+        path = folder / "chase.mcm"
+        path.write_text(CHASE.format(model=model), encoding="utf-8")
+        return path
+    return make
+
+
 def sixteen_unwired(folder: Path) -> Path:
     return write_rig(folder, {f"c{i}": (i, "C-863", SPIN.format(tps=_tps(i)))
                               for i in range(16)}, [])
@@ -108,6 +126,10 @@ CASES = [  # (name, rig maker, --until, --buttons)
     ("(c) raster + 14 unwired busy, 1 h", raster_and_busy, "1h", "x:1@0-100ms"),
     ("(d) w3 token ring, 3600 s", lambda f: write_rig(f, W3, W3_WIRES), "3600s", ""),
     ("(e) slow pair, 3600 s", lambda f: write_rig(f, SLOW, SLOW_WIRES), "3600s", ""),
+    ("(f) chase, C-863, 1 h", chase("C-863"), "1h", ""),
+    ("(f) chase, C-863, 1500 d", chase("C-863"), "1500d", ""),
+    ("(f) chase, C-663, 1 h", chase("C-663"), "1h", ""),
+    ("(f) chase, C-663, 1500 d", chase("C-663"), "1500d", ""),
 ]
 
 

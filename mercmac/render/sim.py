@@ -96,7 +96,9 @@ def _move(t: int, kind: ev.Motion, target: int, arrival: float, segments: tuple)
     """'move to -2000 from 0 (arrives 0.264 s, in 141 ms)'."""
     if arrival <= t:
         return f"{kind} to {target} (no motion)"
-    start = f" from {round(segments[0].x0)}" if segments else ""
+    # where the stage is at t: a profile kept from before (MoveStarted.kept) began earlier
+    start = (f" from {round(next((s for s in segments if t < s.t1), segments[-1]).x(t))}"
+             if segments else "")
     when = "never arrives" if arrival == math.inf else \
         f"arrives {clock(arrival)}, in {format_span(arrival - t)}"
     return f"{kind} to {target}{start} ({when})"
@@ -225,21 +227,22 @@ def timeline(result: Result, level: int = 0) -> list[Line]:
     The story and `-v` stop after TEXT_LIMIT lines; `-vv` shows every line of the
     recorded timeline. Either way the last line counts exactly the lines left out.
     """
-    streams = []
+    streams, shown_copies = [], [0]
     for name, run in result.runs.items():
         streams.append(_named(result, name, run.record.timeline, level))
         if result.rig.several:
-            streams.append(_edges(result, name))
+            streams.append(_edges(result, name, run.record.timeline, shown_copies))
     merged = heapq.merge(*streams, key=lambda pair: pair[0])
     dated = list(islice(merged, TEXT_LIMIT if level < 2 else None))
     cut = sum(1 for _ in merged)  # what the text limit left out
     records = [run.record for run in result.runs.values()]
-    hidden = cut + sum(_unlisted(rec, level) for rec in records) + result.edges_dropped
+    # edges past the cap, but those of skipped passes: the fast-forward lines tell them
+    dropped = result.edges_dropped - (result.edges_copied - shown_copies[0])
+    hidden = cut + sum(_unlisted(rec, level) for rec in records) + dropped
     lines = [line for _, line in dated]
     if hidden:
         lines.append(_left_out(hidden, dated[-1][0] if dated else 0, bool(cut),
-                               any(rec.dropped["timeline"] for rec in records),
-                               result.edges_dropped))
+                               any(rec.dropped["timeline"] for rec in records), dropped))
     return lines
 
 
@@ -264,12 +267,22 @@ def _with_name(line: Line, name: str, width: int) -> Line:
     return line[:1] + [(f"{name:<{width}}  ", "bold blue")] + line[1:]
 
 
-def _edges(result: Result, name: str) -> Iterator[tuple[int, Line]]:
-    """The edges of the wires `name` drives, dated."""
+def _edges(result: Result, name: str, events: list,
+           copies: list[int]) -> Iterator[tuple[int, Line]]:
+    """The edges of the wires `name` drives, dated; but those of passes its fast-forward
+    lines skip (the JSON lists them), counted into copies[0]: a timeline never goes back."""
     width = _width(result)
+    skips = [(e.t, e.t_to) for e in events if type(e) is ev.FastForwarded]
+    i = 0
     for edge in result.edges:
-        if edge.wire.source.controller == name:
-            yield edge.t, at(edge.t) + [(f"{'':<{width}}  wire {_edge_text(edge)}", "cyan")]
+        if edge.wire.source.controller != name:
+            continue
+        while i < len(skips) and skips[i][1] < edge.t:
+            i += 1
+        if i < len(skips) and skips[i][0] < edge.t:  # within (t, t_to]: a copy
+            copies[0] += 1
+            continue
+        yield edge.t, at(edge.t) + [(f"{'':<{width}}  wire {_edge_text(edge)}", "cyan")]
 
 
 def _edge_text(edge: Edge) -> str:

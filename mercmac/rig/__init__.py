@@ -29,7 +29,8 @@ Checking:
     mercmac/rig/open.py            the one way every command opens a rig, or a lone program
 Simulating:
     mercmac/vm/wiring.py           the instant rule: machines joined by wires on one clock
-    mercmac/sim/rig_skip.py        fast-forward over the passes wired controllers repeat jointly
+    mercmac/sim/group.py           the controllers wires join: each group runs on its own
+    mercmac/sim/rig_skip.py        fast-forward over the passes a wired group repeats jointly
     mercmac/sim/rig_deadlock.py    a rig whose controllers wait for good (MH008)
 Drawing:
     mercmac/sim/rig_plot.py        the lanes of several controllers, and the path they draw

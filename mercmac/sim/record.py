@@ -76,23 +76,25 @@ class Block:
     shift: int
     template: tuple
     size: int  # events in one pass
+    steady: bool = False  # the passes leave the running profile as it is (shapes.steady)
 
 
 def _size(entry) -> int:
     return entry.size * entry.passes if isinstance(entry, Block) else 1
 
 
-def _moved(event, dt: int, dx: int, texts):
+def _moved(event, dt: int, dx: int, texts, kept_dt: int):
     """An event of a stepped pass as the pass `dt` us and `dx` counts later makes it; a
     report's text comes from the skip's own reports (shapes.expand) when it shifts.
     (Built by the constructors: dataclasses.replace is four times slower, and a skip may list
     10,000 of them.)"""
     cls = type(event)
     if cls is ev.MoveStarted:
-        t, kind, target, arrival, segments, where = _MOVE_FIELDS(event)
-        return cls(t + dt, kind, target + dx, arrival + dt,
-                   tuple([s.moved(dt, dx) for s in segments]),
-                   where)
+        t, kind, target, arrival, segments, where, kept = _MOVE_FIELDS(event)
+        moved = kept_dt if kept else dt  # a kept profile, from before the pass, stays
+        return cls(t + dt, kind, target + dx, arrival + moved,
+                   tuple([s.moved(moved, dx) for s in segments]),
+                   where, kept)
     if cls is ev.MoveEnded:
         return cls(event.t + dt, event.how, event.position + dx)
     if cls is ev.HomeDefined:
@@ -112,18 +114,21 @@ def _rest(cls: type):
 
 
 def unroll(template: tuple, passes: int, period: int, shift: int, dt: int, dx: int,
-           texts) -> Iterator:
-    """The events of `passes` copies of a stepped pass, inner skips unrolled alike."""
+           texts, steady: bool = False, kept_dt: int = 0) -> Iterator:
+    """The events of `passes` copies of a stepped pass, inner skips unrolled alike. A kept
+    profile (MoveStarted.kept) moves on by `kept_dt` and the periods of the passes that are
+    not steady: a steady pass leaves it where it is in time."""
     for k in range(1, passes + 1):
         at, by = dt + k * period, dx + k * shift
+        kept_at = kept_dt if steady else kept_dt + k * period
         for entry in template:
             if isinstance(entry, Block):
                 if not entry.size:  # passes that did nothing: a million of them list nothing
                     continue
                 yield from unroll(entry.template, entry.passes, entry.period, entry.shift,
-                                  at, by, texts)
+                                  at, by, texts, entry.steady, kept_at)
             else:
-                yield _moved(entry, at, by, texts)
+                yield _moved(entry, at, by, texts, kept_at)
 
 
 def modes(chunks: dict) -> tuple[set[tuple[int, int]], set[int]]:
@@ -214,7 +219,7 @@ class Recorder:
         template = self._pass_before(end, skip.period)
         if template is not None:
             block = Block(end, skip.period, skip.passes, skip.shift, template,
-                          sum(_size(entry) for entry in template))
+                          sum(_size(entry) for entry in template), shapes.keeps(skip.shape))
         elif skip.events is not None:  # a pass of more than RECENT events: counted only
             block = Block(end, skip.period, skip.passes, skip.shift, (), sum(skip.events))
         else:  # a rig's skip of such a pass: a marker only
@@ -228,7 +233,8 @@ class Recorder:
                                   skip.position, skip.shift)
         listed = len(self.events)
         self.events.extend(islice(unroll(block.template, skip.passes, skip.period,
-                                         skip.shift, 0, 0, texts), max(CAP - listed, 0)))
+                                         skip.shift, 0, 0, texts, block.steady),
+                                  max(CAP - listed, 0)))
         self.dropped["events"] += _size(block) - (len(self.events) - listed)
 
     def _pass_before(self, t: int, period: int) -> tuple | None:

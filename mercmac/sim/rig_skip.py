@@ -35,9 +35,11 @@ from mercmac.vm.shapes import moved_shape, plain
 from mercmac.vm.skips import Pass
 
 if TYPE_CHECKING:
-    from mercmac.sim.simulate import Simulation
+    from mercmac.sim.group import Group
 
 SEEN_LIMIT = 4096  # joint keys remembered; a rig whose state never repeats forgets them
+SHAPES_LIMIT = 200_000  # items of the shapes kept; past it, the joint keys are forgotten
+PAUSE_LIMIT = 256  # anchors at most that a repeat which cannot skip leaves uncompared
 
 
 @dataclass(slots=True)
@@ -50,49 +52,93 @@ class JointVisit:
     edges: int  # edges so far, listed or not
     external: float  # the next button or joystick change
     counters: tuple = ()  # every machine's RP counters, {(slot, ip): value}
-    shapes: tuple | None = None  # per machine, the pass that ended here; None: unknown
+    shapes: tuple | None = None  # per machine, the pass that ended here; None: not yet known
     deltas: tuple[int, ...] | None = None
     spent: tuple | None = None  # per machine, how much the pass counted each RP down
+    since: JointVisit | None = None  # where the pass that ended here began, while its
+    # shapes are not known (they are worked out only when its shifts repeat: a long pass
+    # that does not repeat costs nothing to keep)
+    size: int = 0  # items of its shapes, once known
 
 
 class JointForward:
     """Compares the rig at its joint anchors and skips repeating passes."""
 
-    def __init__(self, sim: Simulation):
-        self.sim = sim
-        self.machines = list(sim.wired.machines.values())  # the ones no wire joins skip alone
+    def __init__(self, group: Group):
+        self.group = group
+        self.machines = list(group.machines.values())
         self.seen: dict[tuple, JointVisit] = {}
+        self.arrivals: tuple[int, ...] = ()  # each machine's loop arrivals at the last instant
+        self.kept = 0  # items of the shapes in seen's visits (SHAPES_LIMIT)
+        # A repeat that a boundary keeps from skipping (a float pass at a power of two of
+        # time) is met again at every anchor of the pass until the boundary is passed:
+        # the next `pause` anchors compare only shifts, each such repeat doubling it.
+        self.pause, self.backoff = 0, 1
 
     def arrive(self, t: int, until: int) -> None:
-        """After the instant t: compare the rig with its last visit of the same key."""
+        """After the instant t: compare the rig with its last visit of the same key, if a
+        loop of one of its machines came round at t (a rig whose state repeats comes round
+        the same loops every pass: comparing there finds every repeat, at a fraction of the
+        cost of comparing at every instant)."""
+        arrivals = tuple(m.optimiser.arrivals for m in self.machines)
+        if arrivals == self.arrivals:
+            return
+        self.arrivals = arrivals
         key = self._key(t)
         if key is None:
             return
         visit = JointVisit(t, tuple(m.axis.target for m in self.machines), self._logged(),
-                           len(self.sim.edges) + self.sim.edges_dropped, self._external(),
+                           self.group.edges_seen, self._external(),
                            tuple(m.rp_counters() for m in self.machines))
         previous = self.seen.get(key)
-        if len(self.seen) >= SEEN_LIMIT:
-            self.seen.clear()
+        forgotten = len(self.seen) >= SEEN_LIMIT or self.kept > SHAPES_LIMIT
+        if forgotten:
+            self.forget()
         self.seen[key] = visit
-        if previous is None or not self._repeats(previous, visit):
+        if previous is None:
+            return
+        let_go = 0 if forgotten else previous.size  # the visit `visit` replaces in seen
+        repeats = self._repeats(previous, visit, shapes=not self.pause)
+        self.pause = max(self.pause - 1, 0)
+        self.kept += visit.size - let_go
+        if not repeats:
             return
         period = t - previous.t
         passes = min(self._passes(visit, period, min(until, visit.external)), _left(visit))
         if passes > 0:
             self._jump(key, previous, visit, period, passes)
+            self.backoff = 1
+        else:
+            self.pause, self.backoff = self.backoff, min(2 * self.backoff, PAUSE_LIMIT)
 
-    def _repeats(self, previous: JointVisit, visit: JointVisit) -> bool:
+    def _repeats(self, previous: JointVisit, visit: JointVisit, shapes: bool = True) -> bool:
         """Whether the pass that ended at `visit` is the one that ended at `previous` again
-        (its shapes, shifts and RP counts; nothing from outside in it), noting them."""
+        (its shapes, shifts and RP counts; nothing from outside in it), noting them; False
+        without `shapes` (its shifts only are noted)."""
         if previous.external != visit.external or visit.external <= visit.t:
             return False  # a button or the joystick changed something in the pass
         visit.deltas = tuple(p - q for p, q in zip(visit.positions, previous.positions))
         visit.spent = tuple(_spent(p, v) for p, v in zip(previous.counters, visit.counters))
-        visit.shapes = self._shapes(previous, visit)
-        return (visit.shapes is not None and visit.shapes == previous.shapes
-                and visit.deltas == previous.deltas and visit.spent == previous.spent
-                and None not in visit.spent)
+        visit.since = previous
+        same = (shapes and visit.deltas == previous.deltas and visit.spent == previous.spent
+                and None not in visit.spent and self._shapes_at(visit) is not None
+                and visit.shapes == self._shapes_at(previous))
+        previous.since = None  # (so no chain of visits is kept)
+        return same
+
+    def forget(self) -> None:
+        """Forget every joint visit (a reset, or too many kept)."""
+        self.seen.clear()
+        self.kept = 0
+
+    def _shapes_at(self, visit: JointVisit) -> tuple | None:
+        """The shapes of the pass that ended at `visit`, worked out once."""
+        if visit.shapes is None and visit.since is not None:
+            visit.shapes = self._shapes(visit.since, visit)
+            visit.since = None
+            if visit.shapes is not None:
+                visit.size = sum(len(shape) for shape in visit.shapes)
+        return visit.shapes
 
     # ------------------------------------------------------------ the joint state
     def _key(self, t: int) -> tuple | None:
@@ -102,7 +148,7 @@ class JointForward:
             if part is None:
                 return None
             parts.append(part)
-        parts.append(tuple(self.sim.levels.values()))
+        parts.append(tuple(self.group.levels.values()))
         return tuple(parts)
 
     def _logged(self) -> tuple[int, ...]:
@@ -111,7 +157,8 @@ class JointForward:
     def _external(self) -> float:
         """The next change from outside: a scheduled button or the joystick."""
         t = min(m.inputs.next_change() for m in self.machines)
-        return min(t, self.sim.holds[0][0]) if self.sim.holds else t
+        holds = self.group.holds
+        return min(t, holds[0][0]) if holds else t
 
     def _shapes(self, previous: JointVisit, visit: JointVisit) -> tuple | None:
         """Each machine's pass from `previous` to `visit`, as shapes.moved_shape sees it
@@ -150,27 +197,31 @@ class JointForward:
         self._repeat_edges(previous, visit, period, passes)
         after = JointVisit(visit.t + span,
                            tuple(p + d * passes for p, d in zip(visit.positions, visit.deltas)),
-                           self._logged(), len(self.sim.edges) + self.sim.edges_dropped,
+                           self._logged(), self.group.edges_seen,
                            visit.external, tuple(m.rp_counters() for m in self.machines),
-                           visit.shapes, visit.deltas, visit.spent)
-        self.seen[key] = after
+                           visit.shapes, visit.deltas, visit.spent, size=visit.size)
+        # every other visit is from before the skip: a pass from there would span it, and
+        # a machine's effect log holds none of what the skipped passes emitted (tell)
+        self.seen = {key: after}
+        self.kept = after.size
 
     def _repeat_edges(self, previous: JointVisit, visit: JointVisit, period: int,
                       passes: int) -> None:
         """The wires' edges of the skipped passes: listed up to CAP, the rest counted."""
-        sim = self.sim
+        group = self.group
         count = visit.edges - previous.edges
         if count == 0:
             return  # a pass that changes no wire: nothing to copy, whatever `passes` is
-        listed = [e for e in sim.edges if previous.t < e.t <= visit.t]
-        if len(listed) < count:  # some of the pass's edges were past the cap already
-            sim.edges_dropped += count * passes
+        group.edges_copied += count * passes
+        if group.edges_dropped:  # the list is full: the pass's edges were past the cap too
+            group.edges_dropped += count * passes
             return
+        listed = group.edges[-count:]  # the pass's edges: the last ones, all listed
         for p in range(1, passes + 1):
             for edge in listed:
-                sim.add_edge(type(edge)(edge.t + p * period, edge.wire, edge.level))
-            if len(sim.edges) >= CAP:
-                sim.edges_dropped += count * (passes - p)
+                group.add_edge(type(edge)(edge.t + p * period, edge.wire, edge.level))
+            if len(group.edges) >= CAP:
+                group.edges_dropped += count * (passes - p)
                 return
 
 

@@ -2,17 +2,19 @@
 (docs/simulator.md, docs/rigs.md). A lone program is a rig of one (Rig.of_program).
 
 Each controller is a Machine of its own (vm/machine.py) running its program with a recorder
-(sim/record.py). A controller that no wire joins to another runs alone on its own
-fast-forward (vm/optimiser.py): only its box, its joystick and its scripted presses reach
-it, and it reaches no one. The wired ones advance together, one instant at a time, by the
-instant rule of vm/wiring.py (which the virtual chain of `emulate --rig` follows too), and
-skip the passes they repeat jointly (sim/rig_skip.py). When nothing is left to happen, a rig
-whose controllers all wait for good is dead-locked (sim/rig_deadlock.py).
+(sim/record.py). The controllers that wires join, directly or through others, form a group
+(sim/group.py), and each group runs on its own: a controller no wire joins on its own
+fast-forward (vm/optimiser.py), for only its box, its joystick and its scripted presses reach
+it; the controllers of a wired group together, one instant at a time, by the instant rule of
+vm/wiring.py (which the virtual chain of `emulate --rig` follows too), skipping the passes
+they repeat jointly (sim/rig_skip.py). When nothing is left to happen, a rig whose
+controllers all wait for good is dead-locked (sim/rig_deadlock.py).
 """
 from __future__ import annotations
 
 import heapq
 import time
+from itertools import islice
 from dataclasses import dataclass, replace
 from typing import Iterable, Mapping, Sequence
 
@@ -20,12 +22,13 @@ from mercmac.compiler.program import Program
 from mercmac.errors import signal_of
 from mercmac.rig.model import Rig, Wire
 from mercmac.sim import rig_deadlock
+from mercmac.sim.group import Group, groups_of
 from mercmac.sim.record import CAP, Recorder
 from mercmac.timespec import Press
 from mercmac.vm.machine import Listener, Machine
 from mercmac.vm.models import Options
 from mercmac.vm.optimiser import FastForward
-from mercmac.vm.wiring import INF, Wired
+from mercmac.vm.wiring import INF
 
 DEFAULT_UNTIL_MS = 10_000  # --until defaults to 10s (docs/cli.md, "Commands")
 SLICE_S = 0.1  # wall time per slice of a run that reports progress
@@ -85,6 +88,7 @@ class Result:
     edges_dropped: int = 0  # past CAP edges are counted, not listed (as a run counts its lists)
     interrupted: int = 0  # the signal that stopped the run (SIGINT: Ctrl-C), 0: none
     vcd_cut_at: int | None = None  # us: where the VCD stopped at its size limit
+    edges_copied: int = 0  # edges of skipped passes (sim/rig_skip.py), listed or not
 
     @property
     def hazards(self) -> int:
@@ -139,25 +143,13 @@ class Simulation:
             self.machines[c.name], self.records[c.name] = machine_for(
                 programs[c.name], model=c.model, cycle_ms=cycle_ms, options=own, trace=trace,
                 listeners=(listeners or {}).get(c.name, ()), fast_forward=mode)
-        joined = {end.controller for w in rig.wires for end in (w.source, w.target)}
-        # a controller no wire joins runs alone (its own fast-forward); the others together
-        self.alone = {n: m for n, m in self.machines.items() if n not in joined}
-        self.wired = Wired({n: m for n, m in self.machines.items() if n in joined}, rig.wires,
-                           on_edge=lambda t, wire, level: self.add_edge(Edge(t, wire, level)))
-        self.edges: list[Edge] = []
-        self.edges_dropped = 0
-        # joystick changes (t_us, order, controller, deflection): of the wired machines on the
-        # rig's clock, of each one alone on its own
-        self.holds: list[tuple[int, int, str, float]] = []
-        self.alone_holds: dict[str, list[tuple[int, int, str, float]]] = \
-            {name: [] for name in self.alone}
-        self.held_at = 0  # the last joystick change (us): activity, for a dead-lock's time
+        joint = mode is FastForward.ALL and not trace
+        self.groups = [Group({n: self.machines[n] for n in names},
+                             [w for w in rig.wires if w.source.controller in names],
+                             joint=joint, edge_type=Edge)
+                       for names in groups_of(list(self.machines), rig.wires)]
+        self._group_of = {name: g for g in self.groups for name in g.machines}
         self.deadlocked = False
-        self.joint = None
-        if self.wired.machines and mode is FastForward.ALL and not trace:
-            from mercmac.sim.rig_skip import JointForward
-
-            self.joint = JointForward(self)
 
     # ------------------------------------------------------------ what happens to it
     def press(self, controller: str, presses: Iterable[Press]) -> None:
@@ -171,8 +163,7 @@ class Simulation:
             self._at(hold.end_ms, hold.controller, 0.0)
 
     def _at(self, t_ms: float, controller: str, deflection: float) -> None:
-        into = self.alone_holds.get(controller, self.holds)
-        heapq.heappush(into, (round(t_ms * 1000), len(into), controller, deflection))
+        self._group_of[controller].hold(round(t_ms * 1000), controller, deflection)
 
     def power_on(self) -> None:
         """All controllers power on together, at t = 0 or now (a reset of the whole rig;
@@ -180,72 +171,40 @@ class Simulation:
         for m in self.machines.values():
             m.power_on()
         self.deadlocked = False
-        if self.joint is not None:
-            self.joint.seen.clear()  # passes before the reset are no pattern for after it
-        self.wired.carry(self.now_us())
+        now = self.now_us()
+        for group in self.groups:
+            group.power_on(now)
 
     # ------------------------------------------------------------ the clock
     def run_until(self, until_ms: float) -> None:
-        """Advance every machine to until_ms: each one alone on its own, the wired ones
-        instant by instant (the module's rule); then see whether the rig is dead-locked."""
+        """Advance every group to until_ms on its own (the module's rule); then see whether
+        the rig is dead-locked."""
         until = round(until_ms * 1000)
-        for name, m in self.alone.items():
-            self._run_alone(name, m, until)
-        while not self.deadlocked:
-            t = self.next_us()
-            if t >= until:
-                break
-            self._instant(t)
-            if self.joint is not None:
-                self.joint.arrive(t, until)
-        for m in self.wired.machines.values():
-            m.run(until)
+        for group in self.groups:
+            group.run_until(until)
         if not self.deadlocked and self._still():
             self.deadlocked = rig_deadlock.check(self)
 
-    def _run_alone(self, name: str, m: Machine, until: int) -> None:
-        """A controller no wire joins, to `until` on its own fast-forward; its joystick
-        changes on the way, each before any command at its time."""
-        holds = self.alone_holds[name]
-        while holds and holds[0][0] < until:
-            t, _, _, deflection = heapq.heappop(holds)
-            m.run(t)
-            m.set_joystick(deflection)
-            self.held_at = max(self.held_at, t)
-        m.run(until)
-
     def next_us(self) -> float:
-        """The earliest event of the wired machines or of their joystick; inf when none."""
-        t = self.wired.next_us()
-        return min(t, self.holds[0][0]) if self.holds else t
+        """The earliest event of any machine or of the joystick; inf when none."""
+        return min(g.next_us() for g in self.groups)
 
     @property
-    def levels(self) -> dict[Wire, bool]:
-        """Each wire's level now (its driving output's)."""
-        return self.wired.levels
-
-    def _instant(self, t: int) -> None:
-        self._joystick(t)
-        self.wired.instant(t)
-
-    def _joystick(self, t: int) -> None:
-        while self.holds and self.holds[0][0] <= t:
-            _, _, name, deflection = heapq.heappop(self.holds)
-            self.wired.at(name, t).set_joystick(deflection)
-            self.held_at = max(self.held_at, t)
+    def held_at(self) -> int:
+        """The last joystick change (us): activity, for a dead-lock's time."""
+        return max(g.held_at for g in self.groups)
 
     def _still(self) -> bool:
         """Whether nothing is left to happen: no machine has an event or a command due, no
         joystick change is scripted."""
-        return (not self.holds and not any(self.alone_holds.values())
-                and all(m.next_event_ms() == INF for m in self.machines.values()))
+        return self.next_us() == INF
 
-    def add_edge(self, edge: Edge) -> None:
-        """Keep an edge, up to CAP; past it, count it."""
-        if len(self.edges) < CAP:
-            self.edges.append(edge)
-        else:
-            self.edges_dropped += 1
+    def edges(self) -> tuple[list[Edge], int]:
+        """The wires' edges of every group merged by time (at one instant, in the groups'
+        order), up to CAP; and how many more there were."""
+        merged = list(islice(heapq.merge(*(g.edges for g in self.groups),
+                                         key=lambda e: e.t), CAP))
+        return merged, sum(g.edges_seen for g in self.groups) - len(merged)
 
     def now_us(self) -> int:
         """Where the rig's clock stands: the machines that lag (none runs ahead of it)."""
@@ -287,7 +246,9 @@ class Simulation:
     def result(self, until_ms: int | float, interrupted: int = 0) -> Result:
         runs = {name: Run(m, self.records[name], until_ms, interrupted)
                 for name, m in self.machines.items()}
-        return Result(self.rig, runs, self.edges, until_ms, self.edges_dropped, interrupted)
+        edges, dropped = self.edges()
+        return Result(self.rig, runs, edges, until_ms, dropped, interrupted,
+                      edges_copied=sum(g.edges_copied for g in self.groups))
 
 
 def simulate(rig: Rig, programs: Mapping[str, Program], *,

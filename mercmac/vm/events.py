@@ -99,6 +99,9 @@ class MoveStarted:
     arrival: float  # us; inf when it never arrives
     segments: tuple  # profile.Segment records, for position plots (VCD)
     where: Where | None
+    # the profile running since segments[0].t0 goes on (Axis.keeps): the command planned
+    # it again to where it was going, the same way
+    kept: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -614,15 +614,18 @@ class Machine:
             self.error = code
         self._hazard(rule, variant)
 
-    def _motion(self, kind: ev.Motion, command: Callable[[float], None]) -> None:
-        """Run an axis command now and tell the listeners about the new profile."""
+    def _motion(self, kind: ev.Motion, command: Callable[[float], bool | None]) -> None:
+        """Run an axis command now and tell the listeners about the new profile (or the
+        running one, which a move in flight to where it goes keeps: Axis.keeps)."""
         t = self.clock.now
-        self.optimiser.profile_starting()
-        command(t)
+        note = self.optimiser.profile_note()  # (of the state the profile would start from)
+        kept = bool(command(t))
+        if not kept:
+            self.optimiser.profile_started(note)
         self.mover = self._where(self.ip - 1)  # the command a limit hit will be blamed on
         self._emit(ev.MoveStarted(t, kind, self.axis.target,
                                   self.axis.arrival() if self.axis.moving(t) else t,
-                                  tuple(self.axis.segs), self.mover))
+                                  tuple(self.axis.segs), self.mover, kept))
 
     def _halt(self, kind: ev.Motion) -> None:
         self._motion(kind, self.axis.halt)
@@ -781,7 +784,10 @@ class Machine:
         start = self.wake
         if jump.own is not None:
             self.counters[self.chunk.slot][jump.own] -= jump.passes
-        self._move_on(jump.passes * jump.period, jump.passes * jump.shift)
+        if jump.steady:  # the profile runs on as it was: only the next command moves on
+            self.wake += jump.passes * jump.period
+        else:
+            self._move_on(jump.passes * jump.period, jump.passes * jump.shift)
         if self.on_report is not None:  # the host hears every report (mercmac emulate)
             for r in shapes.expand(jump.shape, start, jump.period, jump.passes, shapes.REPORT,
                                    jump.position, jump.shift):

@@ -188,11 +188,14 @@ class Axis:
         return Side.POSITIVE if p >= hi else Side.NEGATIVE if p <= lo else None
 
     # -- commanding it --
-    def move(self, t: float, target: int, vmax: float | None = None) -> None:
-        """Start a profile to target from the present state of motion."""
+    def move(self, t: float, target: int, vmax: float | None = None) -> bool:
+        """Start a profile to target from the present state of motion; True when the running
+        profile goes on instead (Axis.keeps)."""
+        speed = (self.sv if vmax is None else vmax) * PER_S
+        if self.keeps(t, target, speed):
+            return True
         x, v = self.position(t), self.velocity(t) * PER_S
         self.target = target
-        speed = (self.sv if vmax is None else vmax) * PER_S
         self.stalled = x != target and (speed <= 0 or self.sa <= 0)
         if self.stalled:  # SV0 or SA0: the profile never gets anywhere
             self.segs, self.final, self.plan = (), x, None
@@ -205,6 +208,19 @@ class Axis:
         if self.segs:
             self.negative = self.segs[-1].v0 < 0
         self._find_limit()
+        return False
+
+    def keeps(self, t: float, target: int, speed: float) -> bool:
+        """Whether a move to `target` at `speed` (counts/us) commanded at t leaves the running
+        profile as it is: in flight to that very target, planned with that velocity and SA.
+        A trapezoid planned from any state it passes through is the rest of itself (what
+        stays of it keeps a*d + v^2/2, so the peak, the turn and the deceleration point
+        stay), so the profile planned from here is the one running: planned again in
+        floats it would differ only by rounding, and the stage's path does not change
+        (docs/simulator.md, "Motion")."""
+        p = self.plan
+        return (p is not None and target == p.target == self.target and speed == p.speed
+                and self.sa * PER_S2 == p.acc and not self.stalled and self.moving(t))
 
     def halt(self, t: float) -> None:
         """AB: profile velocity zero at once, target := position (§6.4 AB)."""

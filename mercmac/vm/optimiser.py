@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from mercmac.vm.machine import Machine
 
 INF = math.inf
+STEADY = "steady"  # a key's mark: the axis runs the profile it ran at the visit before
 BUSY_PASSES = 1000  # a loop without waits this long (or endless) is a busy loop hazard
 LOG_LIMIT = 100_000  # effects kept for comparing passes; a longer pass is not skipped
 
@@ -52,10 +53,11 @@ class Jump(NamedTuple):
     own: int | None  # the jumping RP's place, whose counter counts the passes
     passes: int
     period: int
-    shape: tuple  # what each pass emitted (shapes.shape or moved_shape)
+    shape: tuple  # what each pass emitted (shapes.shape, steady or moved_shape)
     position: int  # where the first pass starts (a shifted jump)
     shift: int
     counted: tuple[int, int]  # events of each pass: (others, macro entries and exits)
+    steady: bool = False  # the passes leave the running profile as it is (_key)
 
 
 class Anchors:
@@ -85,6 +87,7 @@ class Optimiser:
         self.waits = 0  # wait commands executed (a loop without any is a busy loop)
         self.inputs = 0  # input changes (a pass that sees one does not repeat)
         self.flows = 0  # macro entries and exits, of skipped passes too (Jump.counted)
+        self.arrivals = 0  # loops come round (macro entries, RP jumps): a rig's anchors
 
     # ------------------------------------------------------------ hooks: the machine says
     def running_to(self, until: int) -> None:
@@ -128,17 +131,22 @@ class Optimiser:
         """A move asked for `target`, clamped to the soft range it was asked in."""
         self.log.append(shapes.Requested(target, *self.machine.axis.soft_range()))
 
-    def profile_starting(self) -> None:
-        """A profile starts: from rest on a count it shifts exactly in any pass; from a moving
-        or a fractional state, only as floats within one power of two (Note.FLOATS); from a
-        profile it cannot key (DH moved it, AB1, a stall), not at all."""
+    def profile_note(self) -> Note | None:
+        """What a profile started now computes with: from rest on a count, whole counts that
+        shift exactly in any pass (None); from a moving or a fractional state, floats, the
+        same only within one power of two (Note.FLOATS); from a profile it cannot key (DH
+        moved it, AB1, a stall), nothing a pass repeats (Note.UNSHIFTABLE)."""
         axis = self.machine.axis
         if axis.at_rest_on_count():
-            return
+            return None
         if axis.stalled or (axis.segs and axis.plan is None):
-            self.log.append(Note.UNSHIFTABLE)
-        else:
-            self.log.append(Note.FLOATS)
+            return Note.UNSHIFTABLE
+        return Note.FLOATS
+
+    def profile_started(self, note: Note | None) -> None:
+        """A profile started (not the running one kept): its profile_note, taken before."""
+        if note is not None:
+            self.log.append(note)
 
     def reported(self, mnemonic: str) -> None:
         """Note how the report just made depends on the position (shapes.moved_shape):
@@ -225,6 +233,7 @@ class Optimiser:
     # ------------------------------------------------------------ at a loop anchor
     def _arrive(self, anchor: Anchor, own: int | None, remaining: float) -> None:
         """A loop came round: report a busy loop, skip identical passes (vm/skips.py)."""
+        self.arrivals += 1
         previous = self.anchors.visits.get(anchor)
         fresh = self._fresh(previous)
         key = self._key(own, previous, fresh)
@@ -243,7 +252,8 @@ class Optimiser:
         passes = skips.skippable(previous, visit, self._bound(), remaining)
         if passes > 0:
             self._jump(Jump(anchor, own, passes, visit.wake - previous.wake, visit.shape,
-                            visit.position, 0, self._counted(previous, visit)), visit)
+                            visit.position, 0, self._counted(previous, visit),
+                            _steady(key)), visit)
 
     def _skip_shifted(self, anchor: Anchor, own: int | None, previous: Visit, visit: Visit,
                       remaining: float) -> None:
@@ -319,7 +329,9 @@ class Optimiser:
         whole = (previous is not None and previous.logged >= self.log_base
                  and self.mode is not FastForward.OFF)  # which compares no passes
         if whole and key is not None and key == previous.key:
-            pass_shape = self.shape(self.log[previous.logged - self.log_base:], previous.wake)
+            shape = shapes.steady if _steady(key) and self.mode is FastForward.ALL \
+                else self.shape
+            pass_shape = shape(self.log[previous.logged - self.log_base:], previous.wake)
         skey, position = self._shift_key(key)
         if (whole and pass_shape is None and skey is not None and skey == previous.skey
                 and self.mode is FastForward.ALL):
@@ -340,13 +352,18 @@ class Optimiser:
         """The machine's state key (Machine.STATE_KEY; `state`, a rig's, if given) at `at`
         (now); while the axis moves, with its profile relative to that time and the target
         (Axis.relative), or None if it has none. Only a pass that planned its profile anew,
-        after one that did too, can repeat one: a profile that ran at the previous visit is
-        not at the same phase now. (So a polling loop that waits for a long move is spared
-        the key at every pass.)"""
+        after one that did too, can repeat one shifted: a profile that ran at the previous
+        visit is not at the same phase now. A pass that left the profile as it was (it
+        planned none, or kept the running one: Axis.keeps) is keyed STEADY, with the
+        profile as it stands: two such passes in a row repeat while the profile runs on,
+        if nothing in them shows where the stage is on it (shapes.steady), up to its next
+        event (its arrival, a limit switch, a trigger pulse: _bound)."""
         m, axis = self.machine, self.machine.axis
         if axis.segs or axis.stalled:
             if previous is not None and not (previous.fresh and fresh):
-                return None
+                if fresh or axis.plan is None or axis.stalled:
+                    return None
+                return STEADY, m._state_key(own) if state is None else state
             relative = axis.relative(m.clock.now if at is None else at)
             if relative is None:
                 return None
@@ -359,7 +376,7 @@ class Optimiser:
         unless the axis rests on its target, a whole count, or moves on a profile it keys;
         with the trigger relative to the target (Trigger.relative)."""
         m = self.machine
-        if key is None:
+        if key is None or _steady(key):  # a steady pass repeats unshifted only
             return None, 0
         axis = m.axis
         trigger = m.trigger.relative(axis.target) if m.trigger.mode else ()
@@ -368,3 +385,8 @@ class Optimiser:
         if axis.final != axis.target:
             return None, 0
         return (m.unshifted(key), trigger), axis.target
+
+
+def _steady(key: tuple | None) -> bool:
+    """Whether a state key is a steady pass's (Optimiser._key)."""
+    return key is not None and key[0] == STEADY

@@ -34,6 +34,7 @@ class Tag(Enum):
     ARRIVE = "arrive"
     ABSOLUTE = "absolute"  # a TS report: it shows the switches, not a relative position
     FLOATS = "floats"  # the pass computes with fractional positions (skips._same_binade)
+    KEPT = "kept"  # a move that keeps the running profile (steady)
 
 
 REPORT, OUTPUTS = Tag.REPORT, Tag.OUTPUTS  # what count and expand select
@@ -94,6 +95,16 @@ class Placed(NamedTuple):
 
 class Absolute(NamedTuple):
     tag: Tag  # Tag.ABSOLUTE or Tag.FLOATS
+
+
+class Kept(NamedTuple):
+    """A move to `target` that kept the running profile (MoveStarted.kept)."""
+
+    tag: Tag  # Tag.KEPT
+    offset: int
+    kind: ev.Motion
+    target: int
+    __match_args__ = ("offset", "kind", "target")
 
 
 class Requested(NamedTuple):
@@ -180,6 +191,32 @@ def shape(events: list, start: int) -> tuple | None:
     return tuple(items)
 
 
+def steady(events: list, start: int) -> tuple | None:
+    """The shape of a pass that leaves the running profile as it is (vm/optimiser.py, a
+    steady key): its moves keep the profile, and nothing in it shows where the stage is on
+    it (a position or velocity report, the switches, a trigger pulse: the notes the
+    optimiser logs for them), so the next pass does the same wherever the stage is; None
+    otherwise."""
+    items = []
+    for e in events:
+        match e:
+            case ev.Reported(t, text, where):
+                items.append(Report(Tag.REPORT, t - start, text, where))
+            case ev.OutputsChanged(t, pattern):
+                items.append(Outputs(Tag.OUTPUTS, t - start, pattern))
+            case ev.MoveStarted() if e.kept:
+                items.append(Kept(Tag.KEPT, e.t - start, e.kind, e.target))
+            case ev.FastForwarded() if e.shift or not plain(e.shape):
+                return None
+            case ev.FastForwarded():
+                items.append(_skip(e, start))
+            case Requested() | Shows():  # a target asked for, the target TT shows
+                pass
+            case _:  # a new profile, an arrival, a note of the position, inputs, hazards
+                return None
+    return tuple(items)
+
+
 def silent(events: list, start: int) -> tuple | None:
     """() when a pass emitted nothing (its effects are notes only), else None: all a
     machine that skips only quiet passes needs of its shape."""
@@ -248,11 +285,17 @@ def _move(e: ev.MoveStarted, start: int, position: int, requested: Requested | N
                 e.arrival - e.t, tuple(s.dt for s in segments), min(ends), max(ends))
 
 
+def keeps(shape: tuple) -> bool:
+    """Whether a pass keeps the running profile (shapes.steady made it: its Kept moves)."""
+    return any(item.tag is Tag.KEPT for item in shape)
+
+
 def plain(shape: tuple) -> bool:
-    """Whether a shape is the same at any position (no moves, no position reports)."""
+    """Whether a shape is the same at any position (no moves, no position reports; a move
+    that keeps the running profile changes nothing: Kept)."""
     for item in shape:
         match item:
-            case Report() | Outputs():
+            case Report() | Outputs() | Kept():
                 pass
             case Skip(shape=inner) if plain(inner):
                 pass

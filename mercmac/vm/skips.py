@@ -215,7 +215,10 @@ def _same_time_binade(now: Visit, period: int, fit: int) -> int:
 
 def _within_binade(lo: int, hi: int, step: int, fit: int) -> int:
     """How many of `fit` steps keep lo..hi, moved on by `step` each, within the power of two
-    and the sign it has now (0 if it is not within one now)."""
+    and the sign it has now (0 if it is not within one now); all of them for a step of 0,
+    which computes the very same values every time."""
+    if step == 0:
+        return fit
     if lo <= 0 <= hi:
         return 0
     if hi < 0:

@@ -52,3 +52,18 @@ def rig_of_one(folder: Path, program: str) -> Path:
     path.write_text('[controllers.s]\naddress = 0\nmodel = "C-663"\nprogram = "s.mcm"\n',
                     encoding="utf-8")
     return path
+
+
+def rig_of_many(folder: Path, programs: list[str], wires: list[str]) -> Path:
+    """A rig file of controllers c0, c1, ... at addresses 0, 1, ..., C-863s and C-663s in
+    turn, with these programs (`target` added) and wires ("c0.out1 -> c1.in2", ...)."""
+    tables = []
+    for i, program in enumerate(programs):
+        model = ("C-863", "C-663")[i % 2]
+        (folder / f"c{i}.mcm").write_text(f"target {model}\n{program}", encoding="utf-8")
+        tables.append(f'[controllers.c{i}]\naddress = {i}\nmodel = "{model}"\n'
+                      f'program = "c{i}.mcm"\n')
+    path = folder / "many.rig.toml"
+    listed = ", ".join(f'"{w}"' for w in wires)
+    path.write_text(f"wires = [{listed}]\n" + "".join(tables), encoding="utf-8")
+    return path

@@ -4,6 +4,7 @@ the joystick, --fail-on-hazard on a dead-locked rig, a VCD with a scope per cont
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 
@@ -113,6 +114,30 @@ def test_an_hour_of_the_raster_as_a_process(tmp_path):
     # 1 row (500 counts) per line: about 2.45 s a pair of lines
     assert out["controllers"]["y"]["final"]["target"] == 1_470_000
     assert len(out["edges"]) == 10_000 and out["truncated"]["edges"] > 0
+
+
+def test_the_timeline_of_a_skipped_hour_never_goes_back():
+    # the skip is one line per controller; the wire edges of its passes are in the JSON only
+    result = sim(RASTER, "--buttons", "x:1@0-100ms", "--until", "1h")
+    assert result.exit_code == 0, result.output
+    times = [_seconds(m.group(1)) for m in map(DATED.match, result.output.splitlines()) if m]
+    assert times == sorted(times) and times[-1] == 3600
+    skips = [line for line in result.output.splitlines() if "fast-forward" in line]
+    assert len(skips) == 2 and all("to 0:59:58.812" in line for line in skips)
+    wires_after = [line for line in result.output.splitlines()
+                   if DATED.match(line) and " wire " in line and _seconds(line.split()[0]) > 7]
+    assert not wires_after
+    # what the cap leaves out is told, counting no edge of the skipped passes
+    assert "... 1 more line after 0:59:59.922" in result.output
+
+
+DATED = re.compile(r" {2,}([\d:]+\.\d{3})(?: s)?  ")  # a timeline line's time column
+
+
+def _seconds(clock: str) -> float:
+    """'6.129' or '0:59:58.812' in seconds."""
+    parts = [float(p) for p in clock.split(":")]
+    return sum(p * 60 ** i for i, p in enumerate(reversed(parts)))
 
 
 SCENARIO = """\

@@ -7,7 +7,6 @@ Trigger pulses (ZM) in such passes repeat too, where the trigger stands alike re
 target (Trigger.relative)."""
 from __future__ import annotations
 
-import dataclasses
 from unittest import mock
 
 import pytest
@@ -16,11 +15,10 @@ from hypothesis import strategies as st
 
 from helpers.budgets import budget
 from helpers.compiling import program_of
-from helpers.simulation import observed
+from helpers.simulation import run_checkpoints, same_as_stepping
 from mercmac.compiler.program import Macro, Op, Program
 from mercmac.sim import record as record_module
 from mercmac.sim.simulate import machine_for
-from mercmac.vm import events as ev
 from mercmac.vm import shapes
 from mercmac.vm.models import Options
 from mercmac.vm.skips import _within_binade
@@ -34,44 +32,6 @@ LONG_BODY = ("autostart {\n  every 30ms { "
 # reports of the position and the velocity taken while the axis moves
 WHILE_MOVING = "autostart {\n  every 7ms { MR 40, WA 3, TP, TV, TE, TD, WS 0 }\n}\n"
 MODELS = ("c-863", "c-663")
-
-
-def run(program: Program, mode: str, checkpoints: list[int], model: str,
-        options: Options | None = None) -> tuple[dict, list]:
-    """What a run gives at each checkpoint (ms): the record, every event but the skip
-    markers, and the machine with its profile; and the skips it made."""
-    machine, record = machine_for(program, model=model, fast_forward=mode, options=options)
-    machine.power_on()
-    seen = []
-    for t in checkpoints:
-        machine.run_until(t)
-        m, axis = machine, machine.axis
-        seen.append((m.clock.now, m.position(), m.target, m.velocity(), m.moving(), m.macro,
-                     m.ip, m.counters, m.block, m.wake, m.error, m.outputs_pattern(),
-                     axis.segs, axis.final, axis.plan, axis.limit))
-    skips = [e for e in record.events if isinstance(e, ev.FastForwarded)]
-    events = [_seen(e) for e in record.events if not isinstance(e, ev.FastForwarded)]
-    return {**observed(record), "events": events, "states": seen}, skips
-
-
-def _seen(event: object) -> object:
-    """An event as JSON and the timeline show it: a listed copy of a move's profile has the
-    stepped one's segments moved on, which agree with those stepping plans to a few ulps (a
-    start time summed in floats), not bit for bit; the machine's own profile does (states)."""
-    if isinstance(event, ev.MoveStarted):
-        return dataclasses.replace(event, segments=tuple(
-            (round(s.t0, 6), round(s.x0, 6), s.v0, s.a, s.dt) for s in event.segments))
-    return event
-
-
-def same_as_stepping(program: Program, checkpoints: list[int], model: str,
-                     options: Options | None = None) -> list:
-    """Assert that skipping gives what stepping gives; the skips made."""
-    with mock.patch.object(record_module, "CAP", 10**7):  # every event listed, none counted
-        fast, skips = run(program, "all", checkpoints, model, options)
-        plain, _ = run(program, "off", checkpoints, model, options)
-    assert fast == plain
-    return skips
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -97,7 +57,7 @@ def test_a_profile_running_across_the_loop_anchor_is_moved_on_as_stepping_plans_
 def test_reports_while_moving_show_the_shifted_positions():
     program = program_of(WHILE_MOVING)
     with mock.patch.object(record_module, "CAP", 10**7):
-        fast, skips = run(program, "all", [60_000], "c-863")
+        fast, skips = run_checkpoints(program, "all", [60_000], "c-863")
     assert any(s.shift == 40 for s in skips)
     positions = [int(text[2:]) for _, text in fast["reports"] if text.startswith("P:")]
     assert len(positions) > 2000 and len(set(positions)) == len(positions)  # each pass on

@@ -1,0 +1,93 @@
+"""A move in flight that a pass commands again to where it goes keeps the running profile
+(Axis.keeps), and passes that leave the profile as it is, and show nothing of where the stage
+is on it, repeat: they are skipped up to the profile's next event (its arrival, a limit
+switch, a trigger pulse), exactly as stepping gives (docs/simulator.md, "Fast-forward")."""
+from __future__ import annotations
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from helpers.budgets import budget
+from helpers.compiling import program_of
+from mercmac.compiler.program import Macro, Op, Program
+from mercmac.vm import events as ev
+from mercmac.vm.models import DEFAULTS, Options
+from mercmac.vm.motion import Axis
+from mercmac.vm.trapezoid import PER_S
+
+MODELS = ("c-863", "c-663")
+from helpers.simulation import same_as_stepping
+
+# the stage chases a target that runs ahead to the soft limit, then cruises to it
+CHASE = ("macro chase {\n  MR 500, TT, MR 25000, CN 1, WA 5, CF 1, goto chase\n}\n"
+         "autostart { goto chase }\n")
+
+
+def test_a_move_commanded_again_to_its_target_keeps_the_profile():
+    axis = Axis(DEFAULTS["C-863"], Options())
+    assert not axis.move(0, 50_000)
+    segs, plan = axis.segs, axis.plan
+    for t in (1_000, 250_000, 700_000):  # accelerating, cruising, (later) slowing down
+        assert axis.move(t, 50_000)
+        assert axis.segs is segs and axis.plan is plan
+    assert not axis.move(800_000, 50_001)  # another target: planned anew from here
+    assert axis.segs[0].t0 == 800_000
+
+
+def test_a_move_at_another_velocity_is_planned_anew():
+    axis = Axis(DEFAULTS["C-863"], Options())
+    axis.move(0, 50_000)
+    assert not axis.move(100_000, 50_000, vmax=axis.sv / 2)  # (the joystick's velocity)
+    assert not axis.move(150_000, 50_000)  # back to SV: planned anew again
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_a_chase_loop_skips_to_the_arrival_exactly(model):
+    program = program_of(CHASE, model)
+    skips = same_as_stepping(program, [20_000, 600_000, 3_000_000], model)
+    # it skips while the stage cruises to the soft limit: once the target is clamped
+    assert sum(s.passes for s in skips) > 10_000
+
+
+def test_a_polling_loop_during_a_long_move_is_skipped_to_the_arrival():
+    source = "autostart {\n  MA 2000000\n  every 20ms { TT, CN 2, WA 3, CF 2 }\n}\n"
+    skips = same_as_stepping(program_of(source, "c-863"), [60_000, 120_000], "c-863")
+    assert skips and sum(s.passes for s in skips) > 2000
+
+
+# -- the property: passes that command a running move again change nothing but the speed --
+body = st.lists(st.sampled_from([
+    ("MA", 40_000), ("MA", -30_000), ("MR", 0), ("MR", 1), ("MR", 25_000), ("TT", None),
+    ("TP", None), ("TV", None), ("TS", None), ("TE", None), ("CN", 1), ("CF", 1), ("WA", 1),
+    ("WA", 5), ("SV", 3000), ("WS", 0), ("AB", None)]), min_size=1, max_size=6)
+tail = st.sampled_from([[("RP", 65535)], [("WA", 2), ("RP", 30), ("RP", 65535)],
+                        [("EM", 4)]])
+limits = st.sampled_from([None, (-90_000, 35_000)])
+trigger = st.sampled_from([[], [("ZM", 2), ("ZP", 5), ("ZI", 1000)], [("ZM", 1), ("ZP", 300)]])
+
+
+@pytest.mark.slow
+@settings(max_examples=budget(100), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(body, tail, limits, trigger, st.sampled_from(MODELS),
+       st.lists(st.integers(10, 40_000), min_size=1, max_size=3))
+def test_passes_that_command_a_running_move_again_give_what_stepping_gives(
+        ops, loop, hard, pulses, model, times):
+    slots = {0: [*pulses, ("EM", 4)], 4: ops + loop}
+    program = Program({s: Macro(s, f"MC{s:02d}", [Op(m, a) for m, a in code])
+                       for s, code in slots.items()})
+    same_as_stepping(program, sorted(set(times)), model, Options(hard_limits=hard))
+
+
+def test_kept_moves_are_told_as_moves_from_where_the_stage_is():
+    # the timeline's "from" is where the stage is when the command runs, not where the
+    # profile began
+    from mercmac.render.sim import event_line
+
+    axis = Axis(DEFAULTS["C-863"], Options())
+    axis.move(0, 50_000)
+    t = 500_000
+    event = ev.MoveStarted(t, ev.Motion.MOVE, 50_000, axis.arrival(), axis.segs, None, True)
+    text = "".join(part for part, _ in event_line(event))
+    assert f"from {round(axis.position(t))} " in text and round(axis.position(t)) > 0
+    assert axis.velocity(t) * PER_S > 0
