@@ -76,7 +76,7 @@ class Block:
     shift: int
     template: tuple
     size: int  # events in one pass
-    steady: bool = False  # the passes leave the running profile as it is (shapes.steady)
+    steady: bool = False  # the passes leave the running profile as it is (shapes.keeps)
 
 
 def _size(entry) -> int:

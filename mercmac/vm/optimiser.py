@@ -53,7 +53,7 @@ class Jump(NamedTuple):
     own: int | None  # the jumping RP's place, whose counter counts the passes
     passes: int
     period: int
-    shape: tuple  # what each pass emitted (shapes.shape, steady or moved_shape)
+    shape: tuple  # what each pass emitted (shapes.shape or moved_shape)
     position: int  # where the first pass starts (a shifted jump)
     shift: int
     counted: tuple[int, int]  # events of each pass: (others, macro entries and exits)
@@ -329,9 +329,10 @@ class Optimiser:
         whole = (previous is not None and previous.logged >= self.log_base
                  and self.mode is not FastForward.OFF)  # which compares no passes
         if whole and key is not None and key == previous.key:
-            shape = shapes.steady if _steady(key) and self.mode is FastForward.ALL \
-                else self.shape
-            pass_shape = shape(self.log[previous.logged - self.log_base:], previous.wake)
+            effects = self.log[previous.logged - self.log_base:]
+            pass_shape = shapes.shape(effects, previous.wake, steady=True) \
+                if _steady(key) and self.mode is FastForward.ALL \
+                else self.shape(effects, previous.wake)
         skey, position = self._shift_key(key)
         if (whole and pass_shape is None and skey is not None and skey == previous.skey
                 and self.mode is FastForward.ALL):
@@ -356,8 +357,8 @@ class Optimiser:
         visit is not at the same phase now. A pass that left the profile as it was (it
         planned none, or kept the running one: Axis.keeps) is keyed STEADY, with the
         profile as it stands: two such passes in a row repeat while the profile runs on,
-        if nothing in them shows where the stage is on it (shapes.steady), up to its next
-        event (its arrival, a limit switch, a trigger pulse: _bound)."""
+        if nothing in them shows where the stage is on it (shapes.shape, `steady`), up to
+        its next event (its arrival, a limit switch, a trigger pulse: _bound)."""
         m, axis = self.machine, self.machine.axis
         if axis.segs or axis.stalled:
             if previous is not None and not (previous.fresh and fresh):

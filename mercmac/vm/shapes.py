@@ -171,8 +171,12 @@ class Stretch(NamedTuple):
 NOTES = (Requested, Shows, Note)  # what the effect log holds besides events
 
 
-def shape(events: list, start: int) -> tuple | None:
-    """A pass's effects relative to its start; None if one of them cannot repeat."""
+def shape(events: list, start: int, steady: bool = False) -> tuple | None:
+    """A pass's effects relative to its start; None if one of them cannot repeat. `steady`:
+    a pass that leaves the running profile as it is (vm/optimiser.py, a steady key): its
+    moves may keep the profile (Kept), and nothing in it may show where the stage is on it
+    (a position or velocity report, the switches, a trigger pulse: the notes the optimiser
+    logs for them), so that the next pass does the same wherever the stage is."""
     items = []
     for e in events:
         match e:
@@ -180,39 +184,17 @@ def shape(events: list, start: int) -> tuple | None:
                 items.append(Report(Tag.REPORT, t - start, text, where))
             case ev.OutputsChanged(t, pattern):
                 items.append(Outputs(Tag.OUTPUTS, t - start, pattern))
+            case ev.MoveStarted() if steady and e.kept:
+                items.append(Kept(Tag.KEPT, e.t - start, e.kind, e.target))
             case ev.FastForwarded() if e.shift or not plain(e.shape):
                 return None  # moves proven exact for its own passes only
             case ev.FastForwarded():
                 items.append(_skip(e, start))
-            case Requested() | Shows() | Note():  # NOTES
+            case Requested() | Shows():  # a target asked for, a position a report shows
+                pass
+            case Note() if not steady:  # (at rest, a pass shows the same positions again)
                 pass
             case _:  # motion, inputs, hazards: not the same in the next pass
-                return None
-    return tuple(items)
-
-
-def steady(events: list, start: int) -> tuple | None:
-    """The shape of a pass that leaves the running profile as it is (vm/optimiser.py, a
-    steady key): its moves keep the profile, and nothing in it shows where the stage is on
-    it (a position or velocity report, the switches, a trigger pulse: the notes the
-    optimiser logs for them), so the next pass does the same wherever the stage is; None
-    otherwise."""
-    items = []
-    for e in events:
-        match e:
-            case ev.Reported(t, text, where):
-                items.append(Report(Tag.REPORT, t - start, text, where))
-            case ev.OutputsChanged(t, pattern):
-                items.append(Outputs(Tag.OUTPUTS, t - start, pattern))
-            case ev.MoveStarted() if e.kept:
-                items.append(Kept(Tag.KEPT, e.t - start, e.kind, e.target))
-            case ev.FastForwarded() if e.shift or not plain(e.shape):
-                return None
-            case ev.FastForwarded():
-                items.append(_skip(e, start))
-            case Requested() | Shows():  # a target asked for, the target TT shows
-                pass
-            case _:  # a new profile, an arrival, a note of the position, inputs, hazards
                 return None
     return tuple(items)
 
@@ -286,7 +268,7 @@ def _move(e: ev.MoveStarted, start: int, position: int, requested: Requested | N
 
 
 def keeps(shape: tuple) -> bool:
-    """Whether a pass keeps the running profile (shapes.steady made it: its Kept moves)."""
+    """Whether a pass keeps the running profile (a steady shape: its Kept moves)."""
     return any(item.tag is Tag.KEPT for item in shape)
 
 
