@@ -98,6 +98,7 @@ class PlotObserver:
     def __init__(self):
         self.trace = Trace()
         self.segments: tuple = ()
+        self.planned = None  # what a kept profile was planned from (MoveStarted.plan)
         self.sampled_to = 0.0
         self.held: dict[int, int] = {}  # input -> since
         self.lit: dict[int, int] = {}  # output -> since
@@ -137,6 +138,7 @@ class PlotObserver:
                 self.trace.target.append((t, target))
                 self._mark(t)
                 self.segments, self.sampled_to = segments, t
+                self.planned = event.plan
             case ev.MoveEnded(_, _, position):
                 self.segments = ()
                 self.trace.position.append((t, float(position)))
@@ -150,7 +152,9 @@ class PlotObserver:
             case ev.FastForwarded(_, t_to, passes, _, loop, shape):
                 self.trace.skips.append((t, t_to, passes, loop.label))
                 self._skipped_outputs(event)
-                if not shapes.plain(shape) or event.shift:
+                if event.steady:
+                    self._steady(event)
+                elif not shapes.plain(shape) or event.shift:
                     self._moved(event)
 
     def _skipped_outputs(self, skip: ev.FastForwarded) -> None:
@@ -164,6 +168,14 @@ class PlotObserver:
         for change in shapes.expand(skip.shape, skip.t, skip.period, skip.passes, shapes.OUTPUTS,
                                     skip.position, skip.shift):
             self._pattern(change.pattern, change.t)
+
+    def _steady(self, skip: ev.FastForwarded) -> None:
+        """Skipped passes that leave the profile going on: the stage follows it through them,
+        to the target they moved it on to (Axis.retarget), sampled as it goes."""
+        if skip.shift:
+            final = skip.position + skip.passes * skip.shift
+            self.segments = self.planned._replace(target=final).segments()
+            self.trace.target.append((skip.t_to, final))
 
     def _moved(self, skip: ev.FastForwarded) -> None:
         """Skipped passes that move: copies of the pass before them while they are few,

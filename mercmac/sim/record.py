@@ -15,6 +15,7 @@ lines it leaves out at each verbosity.
 """
 from __future__ import annotations
 
+import math
 from collections import Counter, deque
 from dataclasses import dataclass, fields
 from functools import lru_cache
@@ -76,25 +77,33 @@ class Block:
     shift: int
     template: tuple
     size: int  # events in one pass
-    steady: bool = False  # the passes leave the running profile as it is (shapes.keeps)
+    steady: bool = False  # the passes leave the running profile going on (shapes.steady)
 
 
 def _size(entry) -> int:
     return entry.size * entry.passes if isinstance(entry, Block) else 1
 
 
-def _moved(event, dt: int, dx: int, texts, kept_dt: int):
+def _moved(event, dt: int, dx: int, texts, kept_dt: int, steady: bool = False):
     """An event of a stepped pass as the pass `dt` us and `dx` counts later makes it; a
     report's text comes from the skip's own reports (shapes.expand) when it shifts.
     (Built by the constructors: dataclasses.replace is four times slower, and a skip may list
     10,000 of them.)"""
     cls = type(event)
     if cls is ev.MoveStarted:
-        t, kind, target, arrival, segments, where, kept = _MOVE_FIELDS(event)
+        t, kind, target, arrival, segments, where, kept, planned = _MOVE_FIELDS(event)
+        if kept and steady and dx:  # the profile from its start to a target further on
+            planned = planned._replace(target=target + dx)  # (Axis.retarget)
+            segments = planned.segments()
+            return cls(t + dt, kind, target + dx, math.ceil(segments[-1].t1), segments,
+                       where, kept, planned)
         moved = kept_dt if kept else dt  # a kept profile, from before the pass, stays
+        if planned is not None:
+            planned = planned._replace(t=planned.t + moved, x=planned.x + dx,
+                                       target=planned.target + dx)
         return cls(t + dt, kind, target + dx, arrival + moved,
                    tuple([s.moved(moved, dx) for s in segments]),
-                   where, kept)
+                   where, kept, planned)
     if cls is ev.MoveEnded:
         return cls(event.t + dt, event.how, event.position + dx)
     if cls is ev.HomeDefined:
@@ -128,7 +137,7 @@ def unroll(template: tuple, passes: int, period: int, shift: int, dt: int, dx: i
                 yield from unroll(entry.template, entry.passes, entry.period, entry.shift,
                                   at, by, texts, entry.steady, kept_at)
             else:
-                yield _moved(entry, at, by, texts, kept_at)
+                yield _moved(entry, at, by, texts, kept_at, steady)
 
 
 def modes(chunks: dict) -> tuple[set[tuple[int, int]], set[int]]:
@@ -219,7 +228,7 @@ class Recorder:
         template = self._pass_before(end, skip.period)
         if template is not None:
             block = Block(end, skip.period, skip.passes, skip.shift, template,
-                          sum(_size(entry) for entry in template), shapes.keeps(skip.shape))
+                          sum(_size(entry) for entry in template), skip.steady)
         elif skip.events is not None:  # a pass of more than RECENT events: counted only
             block = Block(end, skip.period, skip.passes, skip.shift, (), sum(skip.events))
         else:  # a rig's skip of such a pass: a marker only

@@ -64,6 +64,8 @@ class VcdObserver:
         self.sampled_to = 0
         self.last = 0
         self.moves: list = []  # the latest moves: a shifted skip's last pass copies them
+        self.planned = None  # what a kept profile was planned from (MoveStarted.plan)
+        self.retarget: tuple[int, int] | None = None  # (t, target): a steady skip's target
 
     def on_event(self, event) -> None:
         if self.cut_at is None:
@@ -97,6 +99,7 @@ class VcdObserver:
             case ev.MoveStarted(_, _, target, _, segments):
                 w.change(self.target, t, target)
                 self.segments, self.sampled_to = segments, t
+                self.planned = event.plan
                 self.moves = self.moves[-MOVES_KEPT + 1:] + [event]
             case ev.MoveEnded(_, _, position) | ev.HomeDefined(_, position):
                 self.segments = ()
@@ -120,10 +123,18 @@ class VcdObserver:
                 case ev.OutputsChanged(at, pattern):
                     changes += [(at, var, pattern >> i & 1)
                                 for i, var in enumerate(self.outputs)]
-        moves = skip.shift or not shapes.plain(skip.shape)
+        moves = not skip.steady and (skip.shift or not shapes.plain(skip.shape))
         if moves:
             changes += self._last_pass(skip)
+        elif skip.steady and skip.shift:  # the stage follows the profile, planned from its
+            final = skip.position + skip.passes * skip.shift  # start to the last target
+            self.segments = self.planned._replace(target=final).segments()
+            self.retarget = (skip.t_to, final)  # told once the samples reach it
         for t, var, value in sorted(changes, key=lambda change: change[0]):
+            if skip.steady:  # the stage goes on along its profile through the passes
+                self._sample(t)
+                if self.cut_at is not None:  # the samples filled the file
+                    return
             self.writer.change(var, t, value)
             self.last = max(self.last, t)
         if moves:  # a move running across the skip's end runs on as the copy of the one
@@ -156,18 +167,25 @@ class VcdObserver:
         return changes
 
     def _sample(self, until: int) -> None:
-        """Position samples of the running profile up to `until`."""
-        if not self.segments:
-            return
-        end = min(until, int(self.segments[-1].t1) + 1)
-        t = self.sampled_to
-        while t < end:
-            if self._full():
-                self._check_size(t)
-                return
-            self.writer.change(self.position, t, round(_position(self.segments, t)))
-            t += SAMPLE_US
-        self.sampled_to = t
+        """Position samples of the running profile up to `until`, and the target a steady
+        skip left where it left it."""
+        if self.segments:
+            end = min(until, int(self.segments[-1].t1) + 1)
+            t = self.sampled_to
+            while t < end:
+                if self._full():
+                    self._check_size(t)
+                    return
+                self._retargeted(t)
+                self.writer.change(self.position, t, round(_position(self.segments, t)))
+                t += SAMPLE_US
+            self.sampled_to = t
+        self._retargeted(until)
+
+    def _retargeted(self, t: int) -> None:
+        if self.retarget is not None and self.retarget[0] <= t:
+            self.writer.change(self.target, *self.retarget)
+            self.retarget = None
 
     def close(self, t_us: int) -> None:
         if self.cut_at is None:

@@ -99,9 +99,10 @@ class MoveStarted:
     arrival: float  # us; inf when it never arrives
     segments: tuple  # profile.Segment records, for position plots (VCD)
     where: Where | None
-    # the profile running since segments[0].t0 goes on (Axis.keeps): the command planned
-    # it again to where it was going, the same way
+    # the profile running since segments[0].t0 goes on (Axis.keeps), to this target: the
+    # command planned it from the same start, as it was planned, or to a target further on
     kept: bool = False
+    plan: object = None  # what a kept profile was planned from (motion.Plan)
 
 
 @dataclass(frozen=True, slots=True)
@@ -165,6 +166,9 @@ class FastForwarded:
     # each pass, counted: (events other than macro entries and exits, entries and exits), as
     # the JSON `events` holds them (markers aside); None: not counted (a rig's skip)
     events: tuple[int, int] | None = None
+    # the passes left the running profile going on (shapes.steady): the stage follows it
+    # through them, to the target `position + passes * shift` (Axis.retarget)
+    steady: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -625,7 +625,8 @@ class Machine:
         self.mover = self._where(self.ip - 1)  # the command a limit hit will be blamed on
         self._emit(ev.MoveStarted(t, kind, self.axis.target,
                                   self.axis.arrival() if self.axis.moving(t) else t,
-                                  tuple(self.axis.segs), self.mover, kept))
+                                  tuple(self.axis.segs), self.mover, kept,
+                                  self.axis.plan if kept else None))
 
     def _halt(self, kind: ev.Motion) -> None:
         self._motion(kind, self.axis.halt)
@@ -784,8 +785,10 @@ class Machine:
         start = self.wake
         if jump.own is not None:
             self.counters[self.chunk.slot][jump.own] -= jump.passes
-        if jump.steady:  # the profile runs on as it was: only the next command moves on
-            self.wake += jump.passes * jump.period
+        if jump.steady:  # the stage goes on along the profile, to the target the passes
+            self.wake += jump.passes * jump.period  # moved it on to
+            if jump.shift:
+                self.axis.retarget(self.axis.target + jump.passes * jump.shift)
         else:
             self._move_on(jump.passes * jump.period, jump.passes * jump.shift)
         if self.on_report is not None:  # the host hears every report (mercmac emulate)
@@ -795,7 +798,7 @@ class Machine:
         self._emit(ev.FastForwarded(start, self.wake, jump.passes, jump.period,
                                     self._where_anchor(jump.anchor), jump.shape,
                                     jump.position, jump.shift, self.clock.now,
-                                    jump.counted))
+                                    jump.counted, jump.steady))
 
     def skip_passes(self, t: int, passes: int, period: int, shape: tuple, position: int,
                     shift: int, spent: Mapping[tuple[int, int], int]) -> None:

@@ -52,6 +52,23 @@ class Plan(NamedTuple):
     speed: float  # counts/us
     acc: float  # counts/us^2
 
+    def segments(self) -> tuple[Segment, ...]:
+        """The profile planned from it."""
+        return tuple(plan(*self))
+
+
+def shared(p: Plan, segs: tuple, t: float, target: int) -> tuple | None:
+    """The profile planned from p's start to `target` if it takes the path of `segs` (planned
+    from p) up to t: the same segments before the one the stage is on at t, that one the
+    same but for its length, and still on at t; else None (Axis.keeps)."""
+    on = next((i for i, s in enumerate(segs) if t < s.t1), None)
+    if on is None:
+        return None
+    other = p._replace(target=target).segments()
+    same = (len(other) > on and other[:on] == segs[:on] and other[on][:4] == segs[on][:4]
+            and t < other[on].t1)
+    return other if same else None
+
 
 class LimitHit(NamedTuple):
     """When the running profile first reaches a limit switch, and which one."""
@@ -192,7 +209,11 @@ class Axis:
         """Start a profile to target from the present state of motion; True when the running
         profile goes on instead (Axis.keeps)."""
         speed = (self.sv if vmax is None else vmax) * PER_S
-        if self.keeps(t, target, speed):
+        kept = self.keeps(t, target, speed)
+        if kept is not None:
+            if kept is not self.segs:
+                self.plan = self.plan._replace(target=target)
+                self._run(kept)
             return True
         x, v = self.position(t), self.velocity(t) * PER_S
         self.target = target
@@ -210,17 +231,39 @@ class Axis:
         self._find_limit()
         return False
 
-    def keeps(self, t: float, target: int, speed: float) -> bool:
-        """Whether a move to `target` at `speed` (counts/us) commanded at t leaves the running
-        profile as it is: in flight to that very target, planned with that velocity and SA.
-        A trapezoid planned from any state it passes through is the rest of itself (what
-        stays of it keeps a*d + v^2/2, so the peak, the turn and the deceleration point
-        stay), so the profile planned from here is the one running: planned again in
-        floats it would differ only by rounding, and the stage's path does not change
-        (docs/simulator.md, "Motion")."""
+    def keeps(self, t: float, target: int, speed: float) -> tuple | None:
+        """The profile a move to `target` at `speed` (counts/us) commanded at t goes on along,
+        planned from the running plan's start; None when it is planned anew from here.
+
+        In flight, with that velocity and SA, to that very target: the running profile. A
+        trapezoid planned from any state it passes through is the rest of itself (what stays
+        of it keeps a*d + v^2/2, so the peak, the turn and the deceleration point stay), so
+        the profile planned from here is the one running, and planned again in floats it
+        would differ only by rounding. To another target, the profile planned from the same
+        start when it takes the same path up to t (a target further on while the stage has
+        not begun to slow down): the path so far is the stage's, and what follows is what
+        planning from here gives (docs/simulator.md, "Motion")."""
         p = self.plan
-        return (p is not None and target == p.target == self.target and speed == p.speed
-                and self.sa * PER_S2 == p.acc and not self.stalled and self.moving(t))
+        if not (p is not None and p.target == self.target and speed == p.speed
+                and self.sa * PER_S2 == p.acc and not self.stalled and self.moving(t)):
+            return None
+        if target == p.target:
+            return self.segs
+        return shared(p, self.segs, t, target)
+
+    def retarget(self, target: int) -> None:
+        """The running profile planned from its start to `target` (a skip's passes moved it
+        on so, each keeping it: Axis.keeps)."""
+        self.plan = self.plan._replace(target=target)
+        self._run(self.plan.segments())
+
+    def _run(self, segs: tuple) -> None:
+        """Run `segs`, planned from self.plan, to its target."""
+        self.segs = segs
+        self.target = self.plan.target
+        self.final = float(self.target)
+        self.negative = segs[-1].v0 < 0
+        self._find_limit()
 
     def halt(self, t: float) -> None:
         """AB: profile velocity zero at once, target := position (§6.4 AB)."""

@@ -17,6 +17,7 @@ from mercmac.commands import COMMANDS, Mnemonic
 from mercmac.ops import TextEnum
 from mercmac.vm import events as ev
 from mercmac.vm import shapes, skips
+from mercmac.vm.motion import shared
 from mercmac.vm.shapes import Note
 from mercmac.vm.skips import Anchor, Loop, Visit
 
@@ -249,11 +250,58 @@ class Optimiser:
             return
         if visit.shape and self.mode is not FastForward.ALL:
             return
+        steady = _steady(key)
+        if steady and visit.delta != previous.delta:
+            return  # each of the two passes moved the target on by as much, or neither
+        period = visit.wake - previous.wake
         passes = skips.skippable(previous, visit, self._bound(), remaining)
+        if steady:
+            passes = self._steady_passes(visit, period, passes)
         if passes > 0:
-            self._jump(Jump(anchor, own, passes, visit.wake - previous.wake, visit.shape,
-                            visit.position, 0, self._counted(previous, visit),
-                            _steady(key)), visit)
+            self._jump(Jump(anchor, own, passes, period, visit.shape, visit.position,
+                            visit.delta if steady else 0, self._counted(previous, visit),
+                            steady), visit)
+
+    def _steady_passes(self, visit: Visit, period: int, fit: int) -> int:
+        """How many of `fit` passes that leave the running profile going on, their targets
+        each `visit.delta` further on, keep every move they make on it: no target clamped
+        by the soft limits (a clamp is a hazard), and each move to another target made
+        while the stage still takes the path that profile shares with the running one
+        (motion.shared), with a pass to spare: both sides of that are straight lines in the
+        pass's number, so the passes between the first and the last that hold hold too."""
+        axis, delta = self.machine.axis, visit.delta
+        kept = [item for item in visit.shape if item.tag is shapes.Tag.KEPT]
+        for item in kept:
+            if item.requested is not None and delta:
+                lo, hi = item.requested.lo - item.requested.target, \
+                    item.requested.hi - item.requested.target
+                fit = skips.last_inside(lo, hi, visit.position, delta, fit)
+        moving = [item for item in kept if item.target != item.before]
+        if not moving or fit <= 0:
+            return fit
+        p = axis.plan
+        if axis.segs != p.segments():
+            return 0  # a profile moved on in floats (Axis.translate): step it
+
+        def holds(j: int) -> bool:  # pass j of the skip (0: the first) keeps its moves
+            start, begins = visit.position + j * delta, visit.wake + j * period
+            for item in moving:
+                before = p._replace(target=start + item.before)
+                if shared(before, before.segments(), begins + item.offset + period,
+                          start + item.target) is None:
+                    return False
+            return True
+
+        if not holds(0):
+            return 0
+        lo, hi = 0, fit - 1  # the last pass that holds
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            if holds(mid):
+                lo = mid
+            else:
+                hi = mid - 1
+        return lo + 1
 
     def _skip_shifted(self, anchor: Anchor, own: int | None, previous: Visit, visit: Visit,
                       remaining: float) -> None:
@@ -328,12 +376,16 @@ class Optimiser:
         pass_shape = moved = delta = None
         whole = (previous is not None and previous.logged >= self.log_base
                  and self.mode is not FastForward.OFF)  # which compares no passes
+        steady, target = _steady(key), self.machine.axis.target
         if whole and key is not None and key == previous.key:
             effects = self.log[previous.logged - self.log_base:]
-            pass_shape = shapes.shape(effects, previous.wake, steady=True) \
-                if _steady(key) and self.mode is FastForward.ALL \
-                else self.shape(effects, previous.wake)
-        skey, position = self._shift_key(key)
+            if steady and self.mode is FastForward.ALL:
+                pass_shape = shapes.steady(effects, previous.wake, previous.position)
+            else:
+                pass_shape = self.shape(effects, previous.wake)
+            if steady:  # its target moved on by delta, the stage along the profile
+                delta = target - previous.position
+        skey, position = (None, target) if steady else self._shift_key(key)
         if (whole and pass_shape is None and skey is not None and skey == previous.skey
                 and self.mode is FastForward.ALL):
             delta = position - previous.position
@@ -364,7 +416,10 @@ class Optimiser:
             if previous is not None and not (previous.fresh and fresh):
                 if fresh or axis.plan is None or axis.stalled:
                     return None
-                return STEADY, m._state_key(own) if state is None else state
+                p = axis.plan  # its start: the profile to any target is planned from it
+                return (STEADY, m.unshifted(m._state_key(own) if state is None else state),
+                        (p.t, p.x, p.v, p.speed, p.acc), axis.final - axis.target,
+                        m.trigger.next_at)
             relative = axis.relative(m.clock.now if at is None else at)
             if relative is None:
                 return None

@@ -98,13 +98,16 @@ class Absolute(NamedTuple):
 
 
 class Kept(NamedTuple):
-    """A move to `target` that kept the running profile (MoveStarted.kept)."""
+    """A move that kept the running profile (MoveStarted.kept), from the target `before` to
+    `target`, both relative to the pass's start target; `requested`, what it asked for."""
 
     tag: Tag  # Tag.KEPT
     offset: int
     kind: ev.Motion
     target: int
-    __match_args__ = ("offset", "kind", "target")
+    before: int
+    requested: Requested | None
+    __match_args__ = ("offset", "kind", "target", "before", "requested")
 
 
 class Requested(NamedTuple):
@@ -171,12 +174,8 @@ class Stretch(NamedTuple):
 NOTES = (Requested, Shows, Note)  # what the effect log holds besides events
 
 
-def shape(events: list, start: int, steady: bool = False) -> tuple | None:
-    """A pass's effects relative to its start; None if one of them cannot repeat. `steady`:
-    a pass that leaves the running profile as it is (vm/optimiser.py, a steady key): its
-    moves may keep the profile (Kept), and nothing in it may show where the stage is on it
-    (a position or velocity report, the switches, a trigger pulse: the notes the optimiser
-    logs for them), so that the next pass does the same wherever the stage is."""
+def shape(events: list, start: int) -> tuple | None:
+    """A pass's effects relative to its start; None if one of them cannot repeat."""
     items = []
     for e in events:
         match e:
@@ -184,17 +183,46 @@ def shape(events: list, start: int, steady: bool = False) -> tuple | None:
                 items.append(Report(Tag.REPORT, t - start, text, where))
             case ev.OutputsChanged(t, pattern):
                 items.append(Outputs(Tag.OUTPUTS, t - start, pattern))
-            case ev.MoveStarted() if steady and e.kept:
-                items.append(Kept(Tag.KEPT, e.t - start, e.kind, e.target))
-            case ev.FastForwarded() if e.shift or not plain(e.shape):
+            case ev.FastForwarded() if e.shift or e.steady or not plain(e.shape):
                 return None  # moves proven exact for its own passes only
             case ev.FastForwarded():
                 items.append(_skip(e, start))
-            case Requested() | Shows():  # a target asked for, a position a report shows
-                pass
-            case Note() if not steady:  # (at rest, a pass shows the same positions again)
+            case Requested() | Shows() | Note():  # NOTES
                 pass
             case _:  # motion, inputs, hazards: not the same in the next pass
+                return None
+    return tuple(items)
+
+
+def steady(events: list, start: int, position: int) -> tuple | None:
+    """The shape of a pass that leaves the running profile going on (vm/optimiser.py, a
+    steady key), relative to its start time and its start target `position`: its moves keep
+    the profile (Kept), the targets its reports show (TT) are Placed, and nothing in it may
+    show where the stage is on the profile (a position or velocity report, the switches, a
+    trigger pulse: the notes the optimiser logs for them), so that the next pass does the
+    same wherever the stage is, its targets each `delta` further on; None otherwise."""
+    items, requested, target = [], None, position
+    for e in events:
+        match e:
+            case ev.Reported(t, text, where):
+                items.append(Report(Tag.REPORT, t - start, text, where))
+            case ev.OutputsChanged(t, pattern):
+                items.append(Outputs(Tag.OUTPUTS, t - start, pattern))
+            case Shows(ident, value):  # the report just logged shows the target (TT)
+                report = items.pop()
+                items.append(Placed(Tag.PLACED, report.offset, ident, value - position,
+                                    report.where))
+            case Requested(asked, lo, hi):
+                requested = Requested(asked - position, lo, hi)
+            case ev.MoveStarted() if e.kept:
+                items.append(Kept(Tag.KEPT, e.t - start, e.kind, e.target - position,
+                                  target - position, requested))
+                requested, target = None, e.target
+            case ev.FastForwarded() if e.shift or e.steady or not plain(e.shape):
+                return None
+            case ev.FastForwarded():
+                items.append(_skip(e, start))
+            case _:  # a new profile, an arrival, a note of the position, inputs, hazards
                 return None
     return tuple(items)
 
@@ -223,6 +251,8 @@ def moved_shape(events: list, start: int, position: int) -> tuple | None:
                                     report.where))
             case Requested(target, lo, hi):
                 requested = Requested(target - position, lo, hi)
+            case ev.FastForwarded() if e.steady:  # its profile is from before the pass
+                return None
             case ev.FastForwarded() if e.shift or not plain(e.shape):
                 items.append(Shifted(Tag.SHIFTED, e.t - start, e.passes, e.period, e.shape,
                                      e.loop, e.position - position, e.shift))
@@ -265,11 +295,6 @@ def _move(e: ev.MoveStarted, start: int, position: int, requested: Requested | N
         ends.append(x)
     return Move(Tag.MOVE, e.t - start, e.kind, e.target - position, origin, requested,
                 e.arrival - e.t, tuple(s.dt for s in segments), min(ends), max(ends))
-
-
-def keeps(shape: tuple) -> bool:
-    """Whether a pass keeps the running profile (a steady shape: its Kept moves)."""
-    return any(item.tag is Tag.KEPT for item in shape)
 
 
 def plain(shape: tuple) -> bool:

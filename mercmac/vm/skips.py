@@ -234,7 +234,7 @@ def _within_binade(lo: int, hi: int, step: int, fit: int) -> int:
 
 
 EXACT_US = 2**53  # below this, sums of whole floats are exact (_same_arrival)
-FAR = 2**64  # beyond any position (a finite bound: _last_inside divides by the shift)
+FAR = 2**64  # beyond any position (a finite bound: last_inside divides by the shift)
 
 
 def _one_side(now: Visit, edge: float, fit: int) -> int:
@@ -251,7 +251,7 @@ def _one_side(now: Visit, edge: float, fit: int) -> int:
         lo, hi = math.ceil(edge + 1) - low, FAR
     else:
         return 0
-    return max(_last_inside(lo, hi, first, now.delta, fit + 1) - 1, 0)
+    return max(last_inside(lo, hi, first, now.delta, fit + 1) - 1, 0)
 
 
 def _moves(shape: tuple, latest: int, starts: tuple) -> Iterator[tuple[Move, int, tuple]]:
@@ -266,7 +266,7 @@ def _moves(shape: tuple, latest: int, starts: tuple) -> Iterator[tuple[Move, int
                 yield from _moves(inner, latest + offset + n * period, inner_starts)
 
 
-def _last_inside(lo: float, hi: float, first: int, delta: int, fit: int) -> int:
+def last_inside(lo: float, hi: float, first: int, delta: int, fit: int) -> int:
     """How many passes p = 0, 1, ... keep first + p*delta within [lo, hi] (at most fit)."""
     if not lo <= first <= hi:
         return 0
@@ -282,7 +282,7 @@ def _unclamped(move: Move, pos: int, delta: int, fit: int) -> int:
     if move.requested is None or delta == 0:  # a stop, or the very same targets every pass
         return fit
     requested = move.requested
-    return _last_inside(requested.lo, requested.hi, pos + requested.target, delta, fit)
+    return last_inside(requested.lo, requested.hi, pos + requested.target, delta, fit)
 
 
 def _clear(move: Move, pos: int, delta: int, fit: int, hard: tuple | None) -> int:
@@ -292,8 +292,8 @@ def _clear(move: Move, pos: int, delta: int, fit: int, hard: tuple | None) -> in
         return fit
     lo, hi = hard[0] + 2, hard[1] - 2
     low, high = min(move.target, move.low), max(move.target, move.high)
-    return min(_last_inside(lo - low, hi - low, pos, delta, fit),
-               _last_inside(lo - high, hi - high, pos, delta, fit))
+    return min(last_inside(lo - low, hi - low, pos, delta, fit),
+               last_inside(lo - high, hi - high, pos, delta, fit))
 
 
 def _same_arrival(move: Move, wake: int, period: int, fit: int) -> int:

@@ -76,7 +76,7 @@ def same_samples(fast: dict, stepped: dict) -> int:
 
 
 def run_checkpoints(program: Program, mode: str, checkpoints: list[int], model: str,
-        options: Options | None = None) -> tuple[dict, list]:
+                    options: Options | None = None) -> tuple[dict, list]:
     """What a run gives at each checkpoint (ms): the record, every event but the skip
     markers, and the machine with its profile; and the skips it made."""
     machine, record = machine_for(program, model=model, fast_forward=mode, options=options)

@@ -28,11 +28,23 @@ def test_a_move_commanded_again_to_its_target_keeps_the_profile():
     axis = Axis(DEFAULTS["C-863"], Options())
     assert not axis.move(0, 50_000)
     segs, plan = axis.segs, axis.plan
-    for t in (1_000, 250_000, 700_000):  # accelerating, cruising, (later) slowing down
+    for t in (1_000, 250_000, 1_150_000):  # accelerating, cruising, slowing down
         assert axis.move(t, 50_000)
         assert axis.segs is segs and axis.plan is plan
-    assert not axis.move(800_000, 50_001)  # another target: planned anew from here
-    assert axis.segs[0].t0 == 800_000
+    # a target further on while it cruises: planned from the same start, the same path
+    assert axis.move(800_000, 60_000)
+    assert axis.plan == plan._replace(target=60_000) and axis.segs[:1] == segs[:1]
+    assert axis.segs[1][:4] == segs[1][:4] and axis.segs[1].dt > segs[1].dt
+    assert not axis.move(900_000, 40_000)  # one behind it: planned anew from here
+    assert axis.segs[0].t0 == 900_000
+
+
+def test_a_target_further_on_once_it_slows_down_is_planned_anew():
+    axis = Axis(DEFAULTS["C-863"], Options())
+    axis.move(0, 50_000)
+    slowing = axis.segs[-1].t0 + 1_000
+    assert not axis.move(slowing, 60_000)
+    assert axis.segs[0].t0 == slowing
 
 
 def test_a_move_at_another_velocity_is_planned_anew():
@@ -91,3 +103,32 @@ def test_kept_moves_are_told_as_moves_from_where_the_stage_is():
     text = "".join(part for part, _ in event_line(event))
     assert f"from {round(axis.position(t))} " in text and round(axis.position(t)) > 0
     assert axis.velocity(t) * PER_S > 0
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_a_chase_loop_dumps_and_plots_as_stepping_does(model):
+    # the VCD samples the stage along its profile through the skips, the plot draws it
+    import io
+
+    from helpers.simulation import same_samples, vcd_values
+    from mercmac.rig.model import Rig
+    from mercmac.sim.plot import PlotObserver
+    from mercmac.sim.simulate import simulate
+    from mercmac.sim.vcd import Dump
+
+    program = program_of(CHASE, model)
+    rig = Rig.of_program("chase.mcm", model)
+    name = rig.controllers[0].name
+    seen = []
+    for mode in ("all", "off"):
+        out, plot = io.StringIO(), PlotObserver()
+        dump = Dump(out, [name])
+        listeners = {name: [*dump.listeners()[name], plot.on_event]}
+        simulate(rig, {name: program}, until_ms=20_000, listeners=listeners, fast_forward=mode)
+        dump.close(20_000_000)
+        plot.close(20_000_000)
+        seen.append((vcd_values(out.getvalue()), plot.trace))
+    (fast, fast_trace), (plain, plain_trace) = seen
+    assert same_samples(fast, plain) > 1000
+    assert fast_trace.target[-1] == plain_trace.target[-1]
+    assert abs(fast_trace.position[-1][1] - plain_trace.position[-1][1]) < 1
