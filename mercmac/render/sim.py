@@ -82,7 +82,9 @@ def event_line(event) -> Line | None:
             return at(t) + [("program ended: back in direct mode", "bold")]
         case ev.FastForwarded(t, t_to, passes, period, loop, shape, _, shift):
             kind = ("identical pass", "identical passes") if not shift else ("pass", "passes")
-            moved = (f", each {'+' if shift > 0 else '-'}{plural(abs(shift), 'count')} further"
+            whose = "the target " if event.steady else ""  # (the stage runs on its profile)
+            moved = (f", {whose or 'each '}{'+' if shift > 0 else '-'}"
+                     f"{plural(abs(shift), 'count')} further{' each' if whose else ''}"
                      if shift else "")
             return at(t) + [(f"fast-forward {plural(passes, *kind)} of {loop.label} "
                               f"({format_span(period)}{_emitted(shape)} each{moved}) "

@@ -271,11 +271,16 @@ class Optimiser:
         pass's number, so the passes between the first and the last that hold hold too."""
         axis, delta = self.machine.axis, visit.delta
         kept = [item for item in visit.shape if item.tag is shapes.Tag.KEPT]
+        switches = axis.switches()
         for item in kept:
             if item.requested is not None and delta:
                 lo, hi = item.requested.lo - item.requested.target, \
                     item.requested.hi - item.requested.target
                 fit = skips.last_inside(lo, hi, visit.position, delta, fit)
+            if switches is not None and delta:  # a profile to a target 2 counts clear of
+                lo, hi = switches  # the limit switches never reaches them
+                fit = skips.last_inside(lo + 2 - item.target, hi - 2 - item.target,
+                                        visit.position, delta, fit)
         moving = [item for item in kept if item.target != item.before]
         if not moving or fit <= 0:
             return fit

@@ -132,3 +132,11 @@ def test_a_chase_loop_dumps_and_plots_as_stepping_does(model):
     assert same_samples(fast, plain) > 1000
     assert fast_trace.target[-1] == plain_trace.target[-1]
     assert abs(fast_trace.position[-1][1] - plain_trace.position[-1][1]) < 1
+
+
+def test_a_target_running_ahead_toward_a_limit_switch_is_stepped_into_it():
+    # each pass moves the target 25,000 on while the stage cruises: the skip stops before a
+    # target past the switch, whose profile would run into it
+    source = "macro chase {\n  MR 25000, CN 1, WA 5, CF 1, goto chase\n}\nautostart { goto chase }\n"
+    options = Options(hard_limits=(-90_000, 3_000_000))
+    same_as_stepping(program_of(source, "c-663"), [5_000, 200_000], "c-663", options)
