@@ -176,7 +176,22 @@ NOTES = (Requested, Shows, Note)  # what the effect log holds besides events
 
 def shape(events: list, start: int) -> tuple | None:
     """A pass's effects relative to its start; None if one of them cannot repeat."""
-    items = []
+    return _shape(events, start, None)
+
+
+def steady(events: list, start: int, position: int) -> tuple | None:
+    """The shape of a pass that leaves the running profile going on (vm/optimiser.py, a
+    steady key), relative to its start time and its start target `position`: its moves keep
+    the profile (Kept), the targets its reports show (TT) are Placed, and nothing in it may
+    show where the stage is on the profile (a position or velocity report, the switches, a
+    trigger pulse: the notes the optimiser logs for them), so that the next pass does the
+    same wherever the stage is, its targets each `delta` further on; None otherwise."""
+    return _shape(events, start, position)
+
+
+def _shape(events: list, start: int, position: int | None) -> tuple | None:
+    """shape (`position` None: a pass at rest, whose notes change nothing) or steady."""
+    items, requested, target = [], None, position
     for e in events:
         match e:
             case ev.Reported(t, text, where):
@@ -187,42 +202,19 @@ def shape(events: list, start: int) -> tuple | None:
                 return None  # moves proven exact for its own passes only
             case ev.FastForwarded():
                 items.append(_skip(e, start))
-            case Requested() | Shows() | Note():  # NOTES
+            case Requested() | Shows() | Note() if position is None:  # NOTES
                 pass
-            case _:  # motion, inputs, hazards: not the same in the next pass
-                return None
-    return tuple(items)
-
-
-def steady(events: list, start: int, position: int) -> tuple | None:
-    """The shape of a pass that leaves the running profile going on (vm/optimiser.py, a
-    steady key), relative to its start time and its start target `position`: its moves keep
-    the profile (Kept), the targets its reports show (TT) are Placed, and nothing in it may
-    show where the stage is on the profile (a position or velocity report, the switches, a
-    trigger pulse: the notes the optimiser logs for them), so that the next pass does the
-    same wherever the stage is, its targets each `delta` further on; None otherwise."""
-    items, requested, target = [], None, position
-    for e in events:
-        match e:
-            case ev.Reported(t, text, where):
-                items.append(Report(Tag.REPORT, t - start, text, where))
-            case ev.OutputsChanged(t, pattern):
-                items.append(Outputs(Tag.OUTPUTS, t - start, pattern))
             case Shows(ident, value):  # the report just logged shows the target (TT)
                 report = items.pop()
                 items.append(Placed(Tag.PLACED, report.offset, ident, value - position,
                                     report.where))
             case Requested(asked, lo, hi):
                 requested = Requested(asked - position, lo, hi)
-            case ev.MoveStarted() if e.kept:
+            case ev.MoveStarted() if position is not None and e.kept:
                 items.append(Kept(Tag.KEPT, e.t - start, e.kind, e.target - position,
                                   target - position, requested))
                 requested, target = None, e.target
-            case ev.FastForwarded() if e.shift or e.steady or not plain(e.shape):
-                return None
-            case ev.FastForwarded():
-                items.append(_skip(e, start))
-            case _:  # a new profile, an arrival, a note of the position, inputs, hazards
+            case _:  # motion, inputs, hazards, a note of the position on a running profile
                 return None
     return tuple(items)
 
