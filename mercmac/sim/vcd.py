@@ -161,8 +161,10 @@ class VcdObserver:
                              for seg in move.segments)
             if segments:
                 end = min(int(segments[-1].t1), skip.t_to - 1)
+                # from the copy's command on (a kept profile began before it: MoveStarted.kept)
+                begin = max(int(segments[0].t0), move.t + skip.period + dt)
                 changes += [(t, self.position, round(_position(segments, t)))
-                            for t in range(int(segments[0].t0), end, SAMPLE_US)]
+                            for t in range(begin, end, SAMPLE_US)]
                 changes.append((end, self.position, round(_position(segments, end))))
         return changes
 
