@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import heapq
 import time
-from itertools import islice
 from dataclasses import dataclass, replace
+from itertools import islice
 from typing import Iterable, Mapping, Sequence
 
 from mercmac.compiler.program import Program
