@@ -229,17 +229,19 @@ def timeline(result: Result, level: int = 0) -> list[Line]:
     The story and `-v` stop after TEXT_LIMIT lines; `-vv` shows every line of the
     recorded timeline. Either way the last line counts exactly the lines left out.
     """
-    streams, shown_copies = [], [0]
+    streams, copies_listed = [], 0
     for name, run in result.runs.items():
         streams.append(_named(result, name, run.record.timeline, level))
         if result.rig.several:
-            streams.append(_edges(result, name, run.record.timeline, shown_copies))
+            edges, copies = _edges(result, name, run.record.timeline)
+            streams.append(edges)
+            copies_listed += copies
     merged = heapq.merge(*streams, key=lambda pair: pair[0])
     dated = list(islice(merged, TEXT_LIMIT if level < 2 else None))
     cut = sum(1 for _ in merged)  # what the text limit left out
     records = [run.record for run in result.runs.values()]
     # edges past the cap, but those of skipped passes: the fast-forward lines tell them
-    dropped = result.edges_dropped - (result.edges_copied - shown_copies[0])
+    dropped = result.edges_dropped - (result.edges_copied - copies_listed)
     hidden = cut + sum(_unlisted(rec, level) for rec in records) + dropped
     lines = [line for _, line in dated]
     if hidden:
@@ -269,22 +271,23 @@ def _with_name(line: Line, name: str, width: int) -> Line:
     return line[:1] + [(f"{name:<{width}}  ", "bold blue")] + line[1:]
 
 
-def _edges(result: Result, name: str, events: list,
-           copies: list[int]) -> Iterator[tuple[int, Line]]:
-    """The edges of the wires `name` drives, dated; but those of passes its fast-forward
-    lines skip (the JSON lists them), counted into copies[0]: a timeline never goes back."""
+def _edges(result: Result, name: str, events: list) -> tuple[list[tuple[int, Line]], int]:
+    """The edges of the wires `name` drives, dated, but those of passes its fast-forward
+    lines skip (the JSON lists them: a timeline never goes back); and how many those were."""
     width = _width(result)
     skips = [(e.t, e.t_to) for e in events if type(e) is ev.FastForwarded]
-    i = 0
+    lines, copies, i = [], 0, 0
     for edge in result.edges:
         if edge.wire.source.controller != name:
             continue
         while i < len(skips) and skips[i][1] < edge.t:
             i += 1
         if i < len(skips) and skips[i][0] < edge.t:  # within (t, t_to]: a copy
-            copies[0] += 1
+            copies += 1
             continue
-        yield edge.t, at(edge.t) + [(f"{'':<{width}}  wire {_edge_text(edge)}", "cyan")]
+        lines.append((edge.t, at(edge.t) + [(f"{'':<{width}}  wire {_edge_text(edge)}",
+                                             "cyan")]))
+    return lines, copies
 
 
 def _edge_text(edge: Edge) -> str:

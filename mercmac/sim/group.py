@@ -11,7 +11,8 @@ passes its controllers repeat together (sim/rig_skip.py).
 from __future__ import annotations
 
 import heapq
-from typing import Callable, Hashable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Hashable, Mapping, Sequence
 
 from mercmac.rig.model import Wire
 from mercmac.sim.record import CAP
@@ -22,18 +23,26 @@ from mercmac.vm.wiring import Wired
 Held = tuple[int, int, str, float]
 
 
+@dataclass(frozen=True, slots=True)
+class Edge:
+    """A wire changed level at t (us): the driving output's new level."""
+
+    t: int
+    wire: Wire
+    level: bool
+
+
 class Group:
     """Machines by name that wires join, the wires between them, their edges and the joystick
     changes scripted for them."""
 
     def __init__(self, machines: Mapping[str, Machine], wires: Sequence[Wire], *,
-                 joint: bool, edge_type: Callable):
+                 joint: bool):
         self.machines = dict(machines)
         self.wired = Wired(self.machines, wires, on_edge=self._edge)
-        self.edges: list = []  # edge_type(t, wire, level), in time order, up to CAP
+        self.edges: list[Edge] = []  # in time order, up to CAP
         self.edges_dropped = 0
         self.edges_copied = 0  # edges of the passes a joint skip skipped, listed or not
-        self._edge_type = edge_type
         self.holds: list[Held] = []  # a heap
         self.held_at = 0  # the last joystick change (us): activity, for a dead-lock's time
         self.joint = None
@@ -95,9 +104,9 @@ class Group:
 
     # ------------------------------------------------------------ its wires' edges
     def _edge(self, t: int, wire: Wire, level: bool) -> None:
-        self.add_edge(self._edge_type(t, wire, level))
+        self.add_edge(Edge(t, wire, level))
 
-    def add_edge(self, edge) -> None:
+    def add_edge(self, edge: Edge) -> None:
         """Keep an edge, up to CAP; past it, count it (the rig lists the first CAP of all
         its groups' edges, merged by time: none of them is past its own group's CAP)."""
         if len(self.edges) < CAP:

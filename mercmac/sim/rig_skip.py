@@ -29,6 +29,7 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from mercmac.sim.group import Edge
 from mercmac.sim.record import CAP
 from mercmac.vm import events as ev
 from mercmac.vm.shapes import moved_shape, plain
@@ -219,7 +220,7 @@ class JointForward:
         listed = group.edges[-count:]  # the pass's edges: the last ones, all listed
         for p in range(1, passes + 1):
             for edge in listed:
-                group.add_edge(type(edge)(edge.t + p * period, edge.wire, edge.level))
+                group.add_edge(Edge(edge.t + p * period, edge.wire, edge.level))
             if len(group.edges) >= CAP:
                 group.edges_dropped += count * (passes - p)
                 return

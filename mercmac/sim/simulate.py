@@ -20,9 +20,9 @@ from typing import Iterable, Mapping, Sequence
 
 from mercmac.compiler.program import Program
 from mercmac.errors import signal_of
-from mercmac.rig.model import Rig, Wire
+from mercmac.rig.model import Rig
 from mercmac.sim import rig_deadlock
-from mercmac.sim.group import Group, groups_of
+from mercmac.sim.group import Edge, Group, groups_of
 from mercmac.sim.record import CAP, Recorder
 from mercmac.timespec import Press
 from mercmac.vm.machine import Listener, Machine
@@ -32,15 +32,6 @@ from mercmac.vm.wiring import INF
 
 DEFAULT_UNTIL_MS = 10_000  # --until defaults to 10s (docs/cli.md, "Commands")
 SLICE_S = 0.1  # wall time per slice of a run that reports progress
-
-
-@dataclass(frozen=True, slots=True)
-class Edge:
-    """A wire changed level at t (us): the driving output's new level."""
-
-    t: int
-    wire: Wire
-    level: bool
 
 
 @dataclass(frozen=True, slots=True)
@@ -146,7 +137,7 @@ class Simulation:
         joint = mode is FastForward.ALL and not trace
         self.groups = [Group({n: self.machines[n] for n in names},
                              [w for w in rig.wires if w.source.controller in names],
-                             joint=joint, edge_type=Edge)
+                             joint=joint)
                        for names in groups_of(list(self.machines), rig.wires)]
         self._group_of = {name: g for g in self.groups for name in g.machines}
         self.deadlocked = False

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from mercmac.commands import Mnemonic
 from mercmac.ops import TextEnum
 from mercmac.source import Span
-from mercmac.vm.motion import Ended
+from mercmac.vm.motion import Ended, Plan
 
 
 class Motion(TextEnum):
@@ -102,7 +102,7 @@ class MoveStarted:
     # the profile running since segments[0].t0 goes on (Axis.keeps), to this target: the
     # command planned it from the same start, as it was planned, or to a target further on
     kept: bool = False
-    plan: object = None  # what a kept profile was planned from (motion.Plan)
+    plan: Plan | None = None  # what a kept profile was planned from
 
 
 @dataclass(frozen=True, slots=True)

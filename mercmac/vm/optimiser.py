@@ -17,7 +17,6 @@ from mercmac.commands import COMMANDS, Mnemonic
 from mercmac.ops import TextEnum
 from mercmac.vm import events as ev
 from mercmac.vm import shapes, skips
-from mercmac.vm.motion import shared
 from mercmac.vm.shapes import Note
 from mercmac.vm.skips import Anchor, Loop, Visit
 
@@ -263,50 +262,12 @@ class Optimiser:
                             steady), visit)
 
     def _steady_passes(self, visit: Visit, period: int, fit: int) -> int:
-        """How many of `fit` passes that leave the running profile going on, their targets
-        each `visit.delta` further on, keep every move they make on it: no target clamped
-        by the soft limits (a clamp is a hazard), and each move to another target made
-        while the stage still takes the path that profile shares with the running one
-        (motion.shared), with a pass to spare: both sides of that are straight lines in the
-        pass's number, so the passes between the first and the last that hold hold too."""
-        axis, delta = self.machine.axis, visit.delta
-        kept = [item for item in visit.shape if item.tag is shapes.Tag.KEPT]
-        switches = axis.switches()
-        for item in kept:
-            if item.requested is not None and delta:
-                lo, hi = item.requested.lo - item.requested.target, \
-                    item.requested.hi - item.requested.target
-                fit = skips.last_inside(lo, hi, visit.position, delta, fit)
-            if switches is not None and delta:  # a profile to a target 2 counts clear of
-                lo, hi = switches  # the limit switches never reaches them
-                fit = skips.last_inside(lo + 2 - item.target, hi - 2 - item.target,
-                                        visit.position, delta, fit)
-        moving = [item for item in kept if item.target != item.before]
-        if not moving or fit <= 0:
-            return fit
-        p = axis.plan
-        if axis.segs != p.segments():
-            return 0  # a profile moved on in floats (Axis.translate): step it
-
-        def holds(j: int) -> bool:  # pass j of the skip (0: the first) keeps its moves
-            start, begins = visit.position + j * delta, visit.wake + j * period
-            for item in moving:
-                before = p._replace(target=start + item.before)
-                if shared(before, before.segments(), begins + item.offset + period,
-                          start + item.target) is None:
-                    return False
-            return True
-
-        if not holds(0):
-            return 0
-        lo, hi = 0, fit - 1  # the last pass that holds
-        while lo < hi:
-            mid = (lo + hi + 1) // 2
-            if holds(mid):
-                lo = mid
-            else:
-                hi = mid - 1
-        return lo + 1
+        """How many of `fit` passes that leave the running profile going on may be skipped
+        (skips.steady_passes). A profile moved on in floats (Axis.translate) is no longer
+        the one its plan plans: passes that plan from its start are not skipped then."""
+        axis = self.machine.axis
+        plan = axis.plan if axis.segs == axis.plan.segments() else None
+        return skips.steady_passes(visit, period, fit, plan, axis.switches())
 
     def _skip_shifted(self, anchor: Anchor, own: int | None, previous: Visit, visit: Visit,
                       remaining: float) -> None:

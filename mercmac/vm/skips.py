@@ -37,7 +37,9 @@ from enum import Enum
 from fractions import Fraction
 from typing import Iterator, NamedTuple
 
-from mercmac.vm.shapes import ABSOLUTE, FLOATING, Absolute, Arrive, Move, Placed, Shifted
+from mercmac.vm.motion import Plan, shared
+from mercmac.vm.shapes import (ABSOLUTE, FLOATING, Absolute, Arrive, Kept, Move, Placed,
+                               Requested, Shifted)
 
 
 class Loop(Enum):
@@ -140,7 +142,7 @@ def shifted_passes(now: Visit | Pass, period: int, fit: int, bounds: tuple, hard
     same_times = None  # passes within the same power of two of time, when first needed
     for move, latest, starts in _moves(now.moved, 0, (0,)):
         for start in starts:
-            fit = min(fit, _unclamped(move, pos + start, delta, fit),
+            fit = min(fit, _unclamped(move.requested, pos + start, delta, fit),
                       _clear(move, pos + start, delta, fit, hard))
         if floats:  # (_same_binade covers the arrivals of a pass with floats)
             continue
@@ -277,12 +279,55 @@ def last_inside(lo: float, hi: float, first: int, delta: int, fit: int) -> int:
     return fit
 
 
-def _unclamped(move: Move, pos: int, delta: int, fit: int) -> int:
+def _unclamped(requested: Requested | None, pos: int, delta: int, fit: int) -> int:
     """Passes whose move targets stay unclamped (a clamp is a soft-limit boundary)."""
-    if move.requested is None or delta == 0:  # a stop, or the very same targets every pass
+    if requested is None or delta == 0:  # a stop, or the very same targets every pass
         return fit
-    requested = move.requested
     return last_inside(requested.lo, requested.hi, pos + requested.target, delta, fit)
+
+
+def steady_passes(now: Visit, period: int, fit: int, plan: Plan | None,
+                  switches: tuple[float, float] | None) -> int:
+    """How many of `fit` passes that leave the running profile going on (shapes.steady),
+    their targets each `now.delta` further on, keep every move they make on it: no target
+    clamped by the soft limits (a clamp is a hazard) or within 2 counts of a limit switch,
+    and each move to another target made while the stage still takes the path that profile
+    shares with the running one (motion.shared), with a pass to spare. Both sides of that
+    are straight lines in the pass's number, so the passes between the first and the last
+    that hold hold too. `plan`: what the running profile was planned from (None when its
+    segments are no longer those it plans: no move to another target is skipped)."""
+    delta, pos = now.delta, now.position
+    kept = [item for item in now.shape if type(item) is Kept]
+    for item in kept:
+        fit = _unclamped(item.requested, pos, delta, fit)
+        if switches is not None and delta:  # a profile to a target clear of the switches
+            fit = last_inside(switches[0] + 2 - item.target, switches[1] - 2 - item.target,
+                              pos, delta, fit)  # never reaches them
+    moving = [item for item in kept if item.target != item.before]
+    if not moving or fit <= 0:
+        return fit
+    if plan is None:
+        return 0
+
+    def holds(j: int) -> bool:  # pass j of the skip (0: the first) keeps its moves
+        start, begins = pos + j * delta, now.wake + j * period
+        for item in moving:
+            before = plan._replace(target=start + item.before)
+            if shared(before, before.segments(), begins + item.offset + period,
+                      start + item.target) is None:
+                return False
+        return True
+
+    if not holds(0):
+        return 0
+    lo, hi = 0, fit - 1  # the last pass that holds
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if holds(mid):
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo + 1
 
 
 def _clear(move: Move, pos: int, delta: int, fit: int, hard: tuple | None) -> int:
