@@ -18,7 +18,9 @@ up after Ctrl-C (a flash's report, a simulation cut short) does the same for the
 """
 from __future__ import annotations
 
+import contextlib
 import signal
+from typing import Iterator
 
 EXIT_OK = 0
 EXIT_FAILED = 1  # diagnostics with errors, a failed simulation expectation or upload
@@ -39,6 +41,21 @@ class Signalled(KeyboardInterrupt):
     def __init__(self, signum: int):
         super().__init__(signum)
         self.signum = signum
+
+
+@contextlib.contextmanager
+def held_signals() -> Iterator[None]:
+    """Ctrl-C, SIGTERM and SIGHUP wait inside (POSIX), and come right after: for steps a
+    second signal must not cut in half (a file overwritten in place and its restore, a port's
+    close, which would leave pyserial holding a descriptor it already gave back)."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, set(STOPPING))
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def signal_of(interrupt: BaseException) -> int:

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Iterator, NamedTuple
 
-from mercmac.errors import STOPPING, InputError
+from mercmac.errors import STOPPING, InputError, held_signals
 
 TEMP_PREFIX = ".mercmac-"
 TEMP_SUFFIX = ".tmp"
@@ -359,7 +359,7 @@ def _put(tmp: str, target: Path, path) -> None:
 
 def _overwrite(target: Path, new: str, path) -> None:
     """Copy NEW over TARGET in place, whole or not at all (see the module's docstring)."""
-    with _held_signals():  # also while the copy is made and removed: none is left behind
+    with held_signals():  # also while the copy is made and removed: none is left behind
         keep = _copy_beside(target)
         try:
             _copy_into(new, target)
@@ -413,21 +413,6 @@ def _copy_into(source: str | Path, target: Path) -> None:
         out.flush()
         os.ftruncate(out.fileno(), size)
         os.fsync(out.fileno())
-
-
-@contextlib.contextmanager
-def _held_signals() -> Iterator[None]:
-    """Ctrl-C, SIGTERM and SIGHUP wait while a file is overwritten in place (POSIX): the
-    write and, on an I/O error, the restore are never cut in half. They come right after."""
-    held = set(STOPPING)
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    before = signal.pthread_sigmask(signal.SIG_BLOCK, held)
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 class _Terminated(BaseException):

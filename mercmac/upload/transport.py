@@ -12,6 +12,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from typing import Callable, Iterator
 
+from mercmac.errors import held_signals
 from mercmac.upload.protocol import ProtocolError, ReportSplitter
 
 DEFAULT_BAUD = 9600  # MS176E §3.3: MMCRun's rate, DIP switches 5 and 6 ON
@@ -100,10 +101,12 @@ class Transport:
         self.close()
 
     def close(self) -> None:
-        try:
-            self._serial.close()
-        except Exception:  # closing a port that vanished must not hide the real error
-            pass
+        """Close the port whole: a signal waits until it is closed (errors.held_signals)."""
+        with held_signals():
+            try:
+                self._serial.close()
+            except Exception:  # closing a port that vanished must not hide the real error
+                pass
 
     def write(self, data: bytes) -> None:
         """Send `data` in one write, waiting until it has left

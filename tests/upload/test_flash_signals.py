@@ -13,6 +13,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 from contextlib import contextmanager
 from pathlib import Path
@@ -226,3 +227,34 @@ def test_a_signal_while_a_rig_is_written_names_the_signal_and_exits_128_plus_n(s
     assert f"rig flash stopped at x (address 0): flash stopped: interrupted ({how})" \
         in caught.value.message
     assert "x (address 0): partly written; backup of what it held: " in caught.value.message
+
+
+def test_a_signal_while_the_port_closes_waits_until_it_is_closed():
+    """A second signal used to land inside pyserial's close, after the descriptor went back and
+    before pyserial forgot it: at exit its __del__ closed it again ("Exception ignored ... Bad
+    file descriptor"), or closed whatever file had taken the number since."""
+    from mercmac.errors import Signalled
+    from mercmac.upload.transport import Transport
+
+    master, slave = os.openpty()
+    port = Transport(os.ttyname(slave))
+    whole = port._serial.close
+
+    def close_with_a_signal_amid():
+        signal.pthread_kill(threading.get_ident(), signal.SIGTERM)  # as a supervisor's lands
+        whole()
+
+    def signalled(signum, _frame):
+        raise Signalled(signum)
+
+    port._serial.close = close_with_a_signal_amid
+    before = signal.signal(signal.SIGTERM, signalled)
+    try:
+        with pytest.raises(Signalled):
+            port.close()
+        assert port._serial.fd is None and not port._serial.is_open
+    finally:
+        del port._serial.close  # pyserial's own again: its __del__ must not signal later
+        signal.signal(signal.SIGTERM, before)
+        os.close(master)
+        os.close(slave)
