@@ -11,7 +11,7 @@ import re
 from enum import Enum
 from typing import Iterable, Mapping, NamedTuple
 
-from mercmac.suggest import suggest
+from mercmac.suggest import candidates, distance
 
 C663 = "C-663"
 C863 = "C-863"
@@ -404,6 +404,15 @@ def _described(c: Command) -> tuple[str, ...]:
     return tuple(re.findall(r"[a-z0-9]+", f"{c.summary} {c.arg_name} {c.kind.value}".lower()))
 
 
-def nearest(word: str) -> str | None:
-    """The known mnemonic closest to an unknown one (at most 2 edits), for 'did you mean'."""
-    return suggest(word, COMMANDS, limit=2)
+@functools.lru_cache(maxsize=1024)  # a 1 MB line asks for the same few words (check_large)
+def nearest(word: str) -> tuple[str, ...]:
+    """The known mnemonics closest to an unknown one (at most 2 edits), for 'did you mean XF
+    or XN?' (`XM`): of those as close, the ones with its first letter if any (two letters
+    one edit apart are many: `XM` is as near to EM, FM, RM, SM, TM and ZM)."""
+    near = candidates(word, COMMANDS, limit=2)
+    if not near:
+        return ()
+    low = word.lower()
+    best = [n for n in near if distance(low, n.lower()) == distance(low, near[0].lower())]
+    first = [n for n in best if n[0] == word[:1].upper()]
+    return tuple(first or best)

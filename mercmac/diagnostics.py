@@ -8,7 +8,7 @@ Rendering lives in `mercmac.render`.
 from __future__ import annotations
 
 import functools
-from enum import IntEnum
+from enum import Enum, IntEnum
 from typing import Mapping, NamedTuple
 
 from mercmac.source import Span
@@ -485,20 +485,55 @@ def rule(key: str) -> Rule:
     return _BY_KEY.get(key) or _BY_KEY.get(key.upper()) or _BY_KEY[key.lower()]
 
 
+class Applicability(Enum):
+    """How sure a fix is of what the user meant (ruff's applicability; docs/checks.md, "Fixes").
+
+    SAFE: the program surely means this (a `target` line for the model named, a keyword
+    misspelled where only one keyword is that near, a name with exactly one candidate of its
+    kind); `check --fix` applies it. UNSAFE: a guess, such as another command for an unknown
+    one; `--unsafe-fixes` applies it. DISPLAY_ONLY: what to write, shown but never applied
+    (`LED 1`: `CN 1` lights the LED, `CF 1` puts it out)."""
+
+    SAFE = "safe"
+    UNSAFE = "unsafe"
+    DISPLAY_ONLY = "display-only"
+
+    def __str__(self) -> str:
+        return self.value
+
+    def applied(self, unsafe: bool) -> bool:
+        """Whether `check --fix` makes a fix of this kind (`unsafe`: --unsafe-fixes)."""
+        return self is Applicability.SAFE or (unsafe and self is Applicability.UNSAFE)
+
+
+SAFE, UNSAFE, DISPLAY_ONLY = Applicability
+
+
 class Fix(NamedTuple):
-    """A safe edit that resolves a finding, as data (ruff's `Fix` and `fix_title`): put
-    `replacement` in place of `span` (end column exclusive; an empty span inserts). The
-    language server offers it as a quick fix and `check --fix` applies it; the message
-    says it in words, and no one reads it back from there."""
+    """An edit that resolves a finding, as data (ruff's `Fix` and `fix_title`): put
+    `replacement` in place of `span` (end column exclusive; an empty span inserts), as sure
+    of the user's meaning as its `applicability`. The language server offers it as a quick
+    fix, labelled unless it is safe; `check --fix` applies the safe ones (with
+    --unsafe-fixes the unsafe ones too); the JSON and SARIF outputs carry it."""
 
     span: Span
     replacement: str
     title: str
+    applicability: Applicability = Applicability.SAFE
 
     @classmethod
-    def replacing(cls, span: Span, new: str) -> Fix:
-        """A misspelled word at `span` replaced by the known word `new`."""
-        return cls(span, new, _replace_title(new))
+    def replacing(cls, span: Span, new: str, applicability: Applicability) -> Fix:
+        """The word at `span` replaced by the word `new`."""
+        return cls(span, new, _replace_title(new), applicability)
+
+    def as_json(self) -> dict:
+        """`"fix"` of a diagnostic in `check --format json` (docs/cli.md, "JSON output"):
+        its applicability, its title and its one edit (1-based, the end just past)."""
+        span = self.span
+        end = (span.end_line, span.end_column) if span.end_line else (span.line, span.column + 1)
+        return {"applicability": str(self.applicability), "message": self.title,
+                "edits": [{"content": self.replacement, "line": span.line,
+                           "column": span.column, "end_line": end[0], "end_column": end[1]}]}
 
 
 # A 1 MB line of one misspelled command has 250,000 fixes of a few words (check_large).
@@ -531,7 +566,7 @@ class Diagnostic(NamedTuple):
             "end_line": self.end[0],
             "end_column": self.end[1],
             "message": self.message,
-        }
+        } | ({} if self.fix is None else {"fix": self.fix.as_json()})
 
     @property
     def end(self) -> tuple[int, int]:

@@ -308,11 +308,17 @@ def _unknown(word: str) -> Finding:
     if spec is not None and len(word) > 2 and set(word[2:].lower()) <= {"x", "n"}:
         return Finding("syntax", "word", "placeholder", (
             ("expects", spec.expects()), ("placeholder", word[2:])), skip=2)
-    guess = nearest(word.upper())
-    hint = f"; did you mean {guess}?" if guess else ""
+    near = nearest(word.upper())
+    guess = near[0] if near else None
+    hint = f"; did you mean {_either(near)}?" if near else ""
     # `guess` is data for the fix (compiler/checks.py); `hint` says it
     return Finding("unknown-command", "word", "", (("word", word), ("hint", hint),
                                                    ("guess", guess)))
+
+
+def _either(words: tuple[str, ...]) -> str:
+    """'EM', 'EM or XF', 'EM, XF or XN'."""
+    return words[0] if len(words) == 1 else f"{', '.join(words[:-1])} or {words[-1]}"
 
 
 # -- writing ------------------------------------------------------------------------------------

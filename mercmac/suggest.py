@@ -35,3 +35,13 @@ def suggest(word: str, known: Iterable[str], limit: int) -> str | None:
         if cost < best_cost or (cost == best_cost and (best is None or name < best)):
             best, best_cost = name, cost
     return best
+
+
+def candidates(word: str, known: Iterable[str], limit: int) -> list[str]:
+    """Every known word at most `limit` edits from `word`, case aside, nearest first (ties
+    alphabetical): a fix that picks one is sure only when there is one (docs/checks.md,
+    "Fixes")."""
+    low = word.lower()
+    near = [(distance(low, name.lower()), name) for name in known
+            if abs(len(name) - len(low)) <= limit]
+    return [name for cost, name in sorted(near) if cost <= limit]

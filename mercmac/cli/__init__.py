@@ -99,15 +99,18 @@ FORMATS = ["text", "json", "github", "sarif", "concise"]
                    "others (JSON then "
                    'adds "truncated": {FILE: count left out}). The summary counts them all.')
 @click.option("--fix", is_flag=True,
-              help="Apply the safe fixes (misspelled names, commands and keywords; a missing "
-                   "`target` when --target or the settings name the model), then report what "
-                   "remains.")
+              help="Apply the safe fixes (a misspelled keyword; a macro or const name with one "
+                   "candidate; a missing `target` when --target or the settings name the "
+                   "model), then report what remains.")
+@click.option("--unsafe-fixes", "unsafe", is_flag=True,
+              help="With --fix or --diff, apply the unsafe fixes too: guesses such as another "
+                   "command for an unknown one, or the nearest of several names.")
 @click.option("--diff", is_flag=True,
               help="Print the fixes as a unified diff and write nothing; exit 1 if a file "
                    "would change.")
 def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[str, ...],
           ignore: tuple[str, ...], statistics: bool, warnings_as_errors: bool,
-          limit: int | None, fix: bool, diff: bool) -> None:
+          limit: int | None, fix: bool, unsafe: bool, diff: bool) -> None:
     """Check .mcm files, or every .mcm file below a folder, against the firmware's rules.
 
     A rig file (NAME.rig.toml: several controllers on one chain, README "Rigs") is checked
@@ -120,7 +123,9 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
 
     --fix rewrites each file with its safe fixes, whole or not at all (its encoding,
     byte-order mark and line ends kept), says on standard error which fixes it made in
-    which file, and reports the problems that remain.
+    which file, and reports the problems that remain. A safe fix surely keeps what the
+    program means; a guess (`XM 1` -> `EM 1`: another command) is unsafe and waits for
+    --unsafe-fixes. The JSON and SARIF outputs give each fix with its applicability.
 
     Exit 0 when no errors are found, 1 when there are errors (or warnings, with
     --warnings-as-errors), 2 when a file cannot be read (or fixed) or an option or
@@ -131,7 +136,7 @@ def check(files: tuple[str, ...], target: str | None, fmt: str, select: tuple[st
         from mercmac.diagnostics import Severity
 
         chosen = checking.options(target, select or None, ignore or None)
-        fixes = _fixes(files, fix, diff)
+        fixes = _fixes(files, fix, diff, unsafe)
         paths, unreadable = _expand(files)
         results, found = [], []
         for f in paths:
@@ -179,18 +184,22 @@ def _expand(arguments: tuple[str, ...]) -> tuple[list[str], int]:
     return named.files, len(named.skipped) + len(named.empty)
 
 
-def _fixes(files: tuple[str, ...], fix: bool, diff: bool):
+def _fixes(files: tuple[str, ...], fix: bool, diff: bool, unsafe: bool):
     """The fixing of this run (mercmac.cli.fixes), or None when it only checks."""
+    from mercmac.cli.common import UsageError
+
     if not (fix or diff):
+        if unsafe:
+            raise UsageError("--unsafe-fixes goes with --fix or --diff: it adds the unsafe "
+                             "fixes to those they make",
+                             hint="mercmac check --diff --unsafe-fixes FILE shows them")
         return None
     if "-" in files and not diff:
-        from mercmac.cli.common import UsageError
-
         raise UsageError("--fix writes the fixed files back, and standard input is no file",
                          hint="use --diff to see its fixes")
     from mercmac.cli.fixes import Fixes
 
-    return Fixes(diff)
+    return Fixes(diff, unsafe)
 
 
 def _check_file(path: str, chosen, fixes=None) -> tuple[list, int]:

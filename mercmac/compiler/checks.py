@@ -10,12 +10,12 @@ import functools
 from mercmac import mdtext
 from mercmac.commands import MODELS, Arg, lookup
 from mercmac.compiler import ast
-from mercmac.compiler.parse import BROKEN, nearest_keyword
+from mercmac.compiler.parse import BROKEN, keyword_candidates
 from mercmac.compiler.program import MAX_RP, MAX_WA, MAX_WAITS, SLOTS, rp_counts
 from mercmac.ops import Op
-from mercmac.diagnostics import Fix, Report
+from mercmac.diagnostics import DISPLAY_ONLY, SAFE, UNSAFE, Applicability, Fix, Report
 from mercmac.source import Span
-from mercmac.suggest import suggest
+from mercmac.suggest import candidates
 
 MAX_REPEAT = MAX_RP + 1  # `repeat N` lowers to RP N-1; MS176E §6.4 RP: n <= 32568
 MAX_PERIOD_MS = MAX_WA * MAX_WAITS  # `every T` lowers to WA T, several WAs past 65535 ms
@@ -152,9 +152,9 @@ def _first_goto(body: tuple):
 def _macro_name(stmt: ast.Call | ast.Goto, env: Env, report: Report) -> None:
     name = stmt.name
     if name not in env.macros and name not in env.unsure:
-        meant = _nearest(name, env.macros)
+        meant, sure = _nearest(name, env.macros)
         report.add("undefined-name", stmt.span, "macro", name=name, hint=_did_you_mean(meant),
-                   fix=_fix(name_span(stmt), meant))
+                   fix=_fix(name_span(stmt), meant, sure))
 
 
 def name_span(stmt: ast.Call | ast.Goto) -> Span:
@@ -163,14 +163,18 @@ def name_span(stmt: ast.Call | ast.Goto) -> Span:
     return Span(stmt.span.end_line, end - len(stmt.name), stmt.span.end_line, end)
 
 
-def _nearest(name: str, known) -> str | None:
+def _nearest(name: str, known) -> tuple[str | None, Applicability]:
     """The defined name nearest to `name` (mercmac.suggest: at most a third of the name in
-    edits), else the first with the same first three letters; None when none is near."""
-    close = suggest(name, known, limit=len(name) // 3)
-    if close is None:
+    edits), else the first with the same first three letters; None when none is near. SAFE
+    when it is the only name of its kind that near (by its first letters: of two or more),
+    else UNSAFE: one of several is a guess."""
+    near = candidates(name, known, limit=len(name) // 3)
+    if not near:
         low = name.lower()
-        close = min((k for k in known if k.lower().startswith(low[:3])), default=None)
-    return close or None
+        near = sorted(k for k in known if k.lower().startswith(low[:3]))
+        if len(low) < 2:  # one letter begins too many names to be sure of any
+            return (near[0] if near else None), UNSAFE
+    return (near[0], SAFE if len(near) == 1 else UNSAFE) if near else (None, UNSAFE)
 
 
 def _did_you_mean(meant: str | None) -> str:
@@ -178,9 +182,9 @@ def _did_you_mean(meant: str | None) -> str:
     return f"; did you mean '{meant}'?" if meant else ""
 
 
-def _fix(span: Span, meant: str | None) -> Fix | None:
-    """The word at `span` replaced by the one `meant`: safe, as the word is unknown."""
-    return Fix.replacing(span, meant) if meant else None
+def _fix(span: Span, meant: str | None, sure: Applicability) -> Fix | None:
+    """The word at `span` replaced by the one `meant`, as sure as `sure`."""
+    return Fix.replacing(span, meant, sure) if meant else None
 
 
 def _bounded(value: ast.Value, env: Env, report: Report, allowed: range, what: str,
@@ -206,9 +210,9 @@ def _resolve(value: ast.Value, env: Env, report: Report) -> int | None:
         if value.name in env.macros:
             report.add("undefined-name", value.span, "const-is-macro", name=value.name)
         else:
-            meant = _nearest(value.name, env.consts)
+            meant, sure = _nearest(value.name, env.consts)
             report.add("undefined-name", value.span, "const", name=value.name,
-                       hint=_did_you_mean(meant), fix=_fix(value.span, meant))
+                       hint=_did_you_mean(meant), fix=_fix(value.span, meant, sure))
         return None
     env.values[value] = env.consts[value.name]
     return env.consts[value.name]
@@ -231,9 +235,10 @@ def _command(cmd: ast.Command, env: Env, report: Report, *, raw: bool) -> None:
     for f in checked.findings:
         values, where, fix = dict(f.values), _where(cmd, f), None
         if f.rule == "unknown-command":
-            values["hint"], meant = _unknown_hint(cmd.word, _argument(cmd.value), type(cmd.value),
-                                                  raw, values["hint"], values["guess"])
-            fix = Fix.replacing(where, meant) if meant else None
+            values["hint"], meant, sure = _unknown_hint(
+                cmd.word, _argument(cmd.value), type(cmd.value), raw, values["hint"],
+                values["guess"])
+            fix = Fix.replacing(where, meant, sure) if meant else None
         report.add(f.rule, where, f.variant, fix=fix, **values)
     if checked.op is not None:
         env.ops[cmd] = checked.op._replace(span=cmd.span)
@@ -242,22 +247,23 @@ def _command(cmd: ast.Command, env: Env, report: Report, *, raw: bool) -> None:
 # A 1 MB line of unknown commands asks for the same few words 250,000 times (check_large).
 @functools.lru_cache(maxsize=1024)
 def _unknown_hint(word: str, argument: str | None, kind: type, raw: bool, spelling: str,
-                  guess: str | None) -> tuple[str, str | None]:
-    """What an unknown command's message ends with, and the word meant when it is one:
-    the hint of a natural guess (`LED 1`: write `CN 1`; compiler/guesses.py; no word to
-    put in its place), else a keyword misspelled (`cal scan`: a keyword, not a command),
-    else the nearest mnemonic by spelling (mdtext's hint `spelling` and its `guess`).
+                  guess: str | None) -> tuple[str, str | None, Applicability]:
+    """What an unknown command's message ends with, the word meant when there is one, and
+    how sure that is (docs/checks.md, "Fixes"): the hint of a natural guess (`LED 1`: write
+    `CN 1`; compiler/guesses.py; its command only displayed), else a keyword misspelled
+    (`cal scan`: safe when no other keyword is as near), else the nearest mnemonic by
+    spelling (mdtext's hint `spelling` and its `guess`: another command, so unsafe).
     `kind`: the type of the command's value (NoneType when it has none)."""
     from mercmac.compiler import guesses  # only once a command is unknown: `check` starts quick
 
     guessed = guesses.hint(word, argument, raw=raw)
     if guessed is not None:
-        return f"; {guessed}", None
-    keyword = nearest_keyword(word) if not raw and kind is not type(None) else None
-    if keyword is not None:  # only `call NAME` and `goto NAME` are whole without a block
-        return _did_you_mean(keyword), (keyword if keyword in _NAMING and kind is ast.Name
-                                         else None)
-    return spelling, guess
+        return f"; {guessed}", guesses.command(word, raw=raw), DISPLAY_ONLY
+    near = keyword_candidates(word) if not raw and kind is not type(None) else []
+    if near:  # only `call NAME` and `goto NAME` are whole without a block
+        meant = near[0] if near[0] in _NAMING and kind is ast.Name else None
+        return _did_you_mean(near[0]), meant, SAFE if len(near) == 1 else UNSAFE
+    return spelling, guess, UNSAFE
 
 
 _NAMING = ("call", "goto")  # the keywords a statement `KEYWORD NAME` starts with (docs/language.md)

@@ -3,8 +3,9 @@
     source --check--> findings with Fix data --applied, checked again--> fixed text
 
 A fix is data on its diagnostic (mercmac.diagnostics.Fix, made where the check finds the
-problem); the language server offers the same fixes as quick fixes, and the `target`
-line as a source action (`target_fix`). Fixes are made pass after pass on the text the
+problem), with its applicability: only safe fixes are made unless `unsafe` (--unsafe-fixes)
+adds the guesses; display-only ones never are. The language server offers the same fixes
+as quick fixes, and the `target` line as a source action (`target_fix`). Fixes are made pass after pass on the text the
 last pass made; a pass that would make the file parse worse is not made, so a file is
 fixed as a whole or not at all. A file is read and written byte for byte as `fmt` does
 (mercmac.source.decode_exact, mercmac.outfile): its encoding, byte-order mark and line
@@ -17,7 +18,7 @@ from typing import NamedTuple
 
 from mercmac.compiler import checking
 from mercmac.compiler.checking import Choice, Findings, Options
-from mercmac.diagnostics import Diagnostic, Fix
+from mercmac.diagnostics import SAFE, Applicability, Diagnostic, Fix
 from mercmac.errors import InputError
 from mercmac.source import LINE_END, Source, Span, split_lines
 
@@ -44,6 +45,11 @@ class Fixed(NamedTuple):
     findings: Findings
     first: Findings
 
+    def left(self, applicability: Applicability) -> list[Diagnostic]:
+        """The findings after that have a fix of this applicability (not made)."""
+        return [d for d in self.findings.diagnostics
+                if d.fix is not None and d.fix.applicability is applicability]
+
 
 class FileFixed(NamedTuple):
     """What fixing one file did, and why the fixes were not written when they were not
@@ -57,17 +63,18 @@ class FileFixed(NamedTuple):
         return self.fixed.first if self.refused else self.fixed.findings
 
 
-def fix_file(path: str, chosen: Options = Options(), *, write: bool = True) -> FileFixed:
+def fix_file(path: str, chosen: Options = Options(), *, write: bool = True,
+             unsafe: bool = False) -> FileFixed:
     """Fix the file at PATH ('-': standard input, which is never written) under its
-    settings and `chosen`, and write it back byte for byte but for the fixes, if
-    `write`; OSError when it cannot be read."""
+    settings and `chosen`, the unsafe fixes too if `unsafe`, and write it back byte for
+    byte but for the fixes, if `write`; OSError when it cannot be read."""
     from mercmac import outfile
     from mercmac.source import decode, read_bytes
 
     data = read_bytes(path)
     before = None if path == "-" else outfile.snapshot(path, data)
     name = "<stdin>" if path == "-" else path
-    fixed = fix(Source(name, decode(data)), checking.choice_for(path, chosen))
+    fixed = fix(Source(name, decode(data)), checking.choice_for(path, chosen), unsafe=unsafe)
     if not fixed.made:
         return FileFixed(fixed)
     try:
@@ -91,13 +98,15 @@ def _encoding(data: bytes, name: str):
                          hint="fix that byte, or save the file in one encoding") from None
 
 
-def fix(source: Source, choice: Choice) -> Fixed:
-    """`source` with the fixes of what `check` reports made, then a `target` line for the
-    model chosen (`--target`, or the settings) when the text names none."""
+def fix(source: Source, choice: Choice, *, unsafe: bool = False) -> Fixed:
+    """`source` with the safe fixes of what `check` reports made (the unsafe ones too if
+    `unsafe`), then a `target` line for the model chosen (`--target`, or the settings)
+    when the text names none."""
     first = checking.check(source, choice)
     findings, made = first, []
     for _ in range(MAX_PASSES):
-        wanted = [Made(d.fix, d) for d in findings.diagnostics if d.fix is not None]
+        wanted = [Made(d.fix, d) for d in findings.diagnostics
+                  if d.fix is not None and d.fix.applicability.applied(unsafe)]
         better = _better(findings, wanted, choice)
         if better is None:
             break
@@ -186,4 +195,4 @@ def target_fix(text: str, model: str | None) -> Fix | None:
         last = len(lines[-1]) + 1
         at, new = Span(len(lines), last, len(lines), last), \
             f"{end if lines[-1] else ''}target {model}{end}"
-    return Fix(at, new, f"Add `target {model}`")
+    return Fix(at, new, f"Add `target {model}`", SAFE)  # the model the user named

@@ -110,6 +110,15 @@ def hint(word: str, after: str | None = None, *, raw: bool = False) -> str | Non
     return found.hint.format(n=_number(after[then.end():] if pair else after, found.duration))
 
 
+def command(word: str, *, raw: bool = False) -> str | None:
+    """The command a one-word guess names first (`LED`: CN), for a fix that is displayed,
+    never applied; None for a construct of the language, or in a raw block."""
+    found = guess(word)
+    if found is None or found.construct or raw:
+        return None
+    return found.commands[0]
+
+
 def _number(after: str, duration: bool) -> str:
     """The user's number as the hint writes it; 'n' when there is none (or it makes none)."""
     m = _NUMBER.match(after)

@@ -26,7 +26,7 @@ from typing import NamedTuple
 from mercmac import mdtext
 from mercmac.commands import Mnemonic, lookup
 from mercmac.compiler import parser_tables as lark
-from mercmac.diagnostics import Fix, Report
+from mercmac.diagnostics import SAFE, UNSAFE, Fix, Report
 from mercmac.source import Span, to_lf
 
 # `when`/`repeat`/`every` blocks nested deeper cannot fit the controller: each level needs
@@ -596,20 +596,20 @@ _UNIT = re.compile(r"(ms|s|min|h|d|mm|um|nm|cm|m|deg|counts?|cts|steps?)(?![A-Za
 _IN_MS = (Mnemonic.WA, Mnemonic.WS)  # commands whose argument is milliseconds (MS176E §6.4)
 
 
-def nearest_keyword(word: str) -> str | None:
-    """The keyword a misspelled word most likely means (`whne` -> `when`), or None: one or
-    two edits away (mercmac.suggest), or, past three letters, its letters shuffled."""
-    from mercmac.suggest import suggest
+def keyword_candidates(word: str) -> list[str]:
+    """The keywords a misspelled word may mean, likeliest first: one or two edits away
+    (mercmac.suggest), or, past three letters, its letters shuffled. One alone is a safe
+    fix (docs/checks.md, "Fixes")."""
+    from mercmac.suggest import candidates
 
     low = word.lower()
     if low in KEYWORDS:  # `When 1`: keywords are lower case
-        return low if word != low else None
+        return [low] if word != low else []
     if len(low) < 3:
-        return None
-    near = suggest(low, KEYWORDS, limit=1 if len(low) < 4 else 2)
-    if near is None and len(low) > 3:
-        nearest = suggest(low, KEYWORDS, limit=len(low) + len(max(KEYWORDS, key=len)))
-        near = nearest if sorted(low) == sorted(nearest) else None
+        return []
+    near = candidates(low, KEYWORDS, limit=1 if len(low) < 4 else 2)
+    if not near and len(low) > 3:
+        near = [k for k in KEYWORDS if sorted(low) == sorted(k)]
     return near
 
 
@@ -643,11 +643,12 @@ def _hint(e, text: str, line: int):
         word = m.group(1)
         if m.start(1) > here or lookup(word) is not None:
             continue
-        keyword = nearest_keyword(word)
-        if keyword is not None:
+        near = keyword_candidates(word)
+        if near:
             span = Span(row, m.start(1) + 1, row, m.end(1) + 1)
-            return span, "keyword", {"word": word, "keyword": keyword,
-                                     "fix": Fix.replacing(span, keyword)}
+            sure = SAFE if len(near) == 1 else UNSAFE
+            return span, "keyword", {"word": word, "keyword": near[0],
+                                     "fix": Fix.replacing(span, near[0], sure)}
     word = _WORD.match(code, here) if here < len(code) else None
     before = code[:here]
     if word is not None and word.group().lower() == "or" and re.search(r"\bwhen\b", before):

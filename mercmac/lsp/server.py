@@ -28,7 +28,7 @@ from pygls.lsp.server import LanguageServer
 from mercmac import __version__, config
 from mercmac.commands import MODELS, Mnemonic
 from mercmac.compiler import Compilation, checking
-from mercmac.diagnostics import Diagnostic, Fix, Report, Severity
+from mercmac.diagnostics import DISPLAY_ONLY, SAFE, UNSAFE, Diagnostic, Fix, Report, Severity
 from mercmac.errors import MercmacError, SettingsError
 from mercmac.lsp import completion as completion_rules, framing, rig, settings, symbols
 from mercmac.lsp.document import Document, Documents
@@ -625,13 +625,25 @@ def code_actions(ls: MercmacServer, params: t.CodeActionParams) -> list[t.CodeAc
     wanted = (document.spot(params.range.start), document.spot(params.range.end))
     out = []
     if _wanted(params.context.only, t.CodeActionKind.QuickFix):
-        out += [t.CodeAction(title=d.fix.title, kind=t.CodeActionKind.QuickFix,
-                             diagnostics=[_diagnostic(d, document)], is_preferred=True,
+        out += [t.CodeAction(title=fix_label(d.fix), kind=t.CodeActionKind.QuickFix,
+                             diagnostics=[_diagnostic(d, document)],
+                             is_preferred=d.fix.applicability is SAFE,
                              edit=_edit(uri, document, d.fix))
                 for d in seen.diagnostics if d.fix is not None and _touches(d.span, *wanted)]
     if _wanted(params.context.only, ADD_TARGET) and not seen.rig:
         out += _add_target(uri, seen, document)
     return out
+
+
+# What a quick fix's title adds for each applicability (docs/editors.md): a safe fix is
+# preferred (the editor's "auto fix" takes it); the others say what they are.
+_LABELS = {SAFE: "", UNSAFE: " (unsafe: a guess, check what it changes)",
+           DISPLAY_ONLY: " (suggestion: check --fix never makes it)"}
+
+
+def fix_label(fix: Fix) -> str:
+    """The title the editor shows for a fix: 'Replace with 'WA' (unsafe: a guess, ...)'."""
+    return fix.title + _LABELS[fix.applicability]
 
 
 def _edit(uri: str, document: Document, fix: Fix) -> t.WorkspaceEdit:

@@ -256,8 +256,24 @@ def _sarif_result(d: Diagnostic, rule_index: int) -> dict:
     region = {"startLine": d.span.line, "startColumn": d.span.column,
               "endLine": end_line, "endColumn": end_column}
     location = {"artifactLocation": {"uri": _uri(d.file)}, "region": region}
-    return {"ruleId": d.rule.code, "ruleIndex": rule_index, "level": _SARIF_LEVEL[d.severity],
-            "message": {"text": d.message}, "locations": [{"physicalLocation": location}]}
+    result = {"ruleId": d.rule.code, "ruleIndex": rule_index, "level": _SARIF_LEVEL[d.severity],
+              "message": {"text": d.message}, "locations": [{"physicalLocation": location}]}
+    if d.fix is not None:
+        result["fixes"] = [_sarif_fix(d)]
+    return result
+
+
+def _sarif_fix(d: Diagnostic) -> dict:
+    """A result's fix (SARIF §3.55): its title, the one replacement, and its applicability
+    as a property, as ruff writes it."""
+    edit = d.fix.as_json()["edits"][0]
+    deleted = {"startLine": edit["line"], "startColumn": edit["column"],
+               "endLine": edit["end_line"], "endColumn": edit["end_column"]}
+    return {"description": {"text": d.fix.title},
+            "artifactChanges": [{"artifactLocation": {"uri": _uri(d.file)},
+                                 "replacements": [{"deletedRegion": deleted,
+                                                   "insertedContent": {"text": edit["content"]}}]}],
+            "properties": {"applicability": str(d.fix.applicability)}}
 
 
 def _uri(file: str) -> str:

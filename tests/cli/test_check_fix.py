@@ -15,8 +15,9 @@ from mercmac.source import Span
 from helpers.cli import cli, mercmac_process
 from helpers.files import leftovers
 
-# One of each fix: a mnemonic, a const, a keyword written as a command (`cal`), a macro
-# name, and a keyword the parser stops at (`whne`); `LED 1` has a hint but no fix.
+# One of each fix: a mnemonic (unsafe: another command), a const, a keyword written as a
+# command (`cal`), a macro name, and a keyword the parser stops at (`whne`); `LED 1` has a
+# hint and a fix that is only displayed (`CN`).
 BROKEN = """\
 // jog box
 const FAST = 5000
@@ -43,23 +44,51 @@ def _write(path, text: str, *, end: str = "\n", encoding: str = "utf-8", bom: by
 
 # -- in-process (click's CliRunner) ------------------------------------------------------------
 
-def test_fix_rewrites_the_file_and_says_which_fixes_it_made(tmp_path):
+def test_fix_makes_the_safe_fixes_and_says_which_it_made_and_which_it_did_not(tmp_path):
     f = _write(tmp_path / "jog.mcm", BROKEN)
     result = cli("check", "--fix", f)
-    assert f.read_text(encoding="utf-8") == FIXED
+    assert f.read_text(encoding="utf-8") == FIXED.replace("MR 5", "MRR 5")
     assert result.stderr.splitlines() == [
-        f"fixed {f} (5 fixes):",
-        "  3:14: unknown-command: Replace with 'MR'",
+        f"fixed {f} (4 fixes):",
         "  3:24: undefined-name: Replace with 'FAST'",
         "  4:13: unknown-command: Replace with 'call'",
         "  4:28: undefined-name: Replace with 'scan'",
         "  6:14: syntax: Replace with 'when'",
-        "1 file fixed (5 fixes)",
+        "1 file fixed (4 fixes)",
+        "1 unsafe fix not made: each is a guess that may change what the program does "
+        "(another command, one of several names); `--unsafe-fixes` makes them, "
+        "`--diff --unsafe-fixes` shows them",
     ]
     # what remains is reported as `check` reports it, and makes the exit code
     assert result.exit_code == 1
-    assert "unknown command 'LED'" in result.stdout and "MRR" not in result.stdout
-    assert result.stdout.rstrip().endswith("1 error, 0 warnings, 1 info in 1 file.")
+    assert "unknown command 'LED'" in result.stdout and "unknown command 'MRR'" in result.stdout
+    assert result.stdout.rstrip().endswith("2 errors, 0 warnings, 1 info in 1 file.")
+
+
+def test_unsafe_fixes_makes_the_guesses_too_and_labels_them(tmp_path):
+    f = _write(tmp_path / "jog.mcm", BROKEN)
+    result = cli("check", "--fix", "--unsafe-fixes", f)
+    assert f.read_text(encoding="utf-8") == FIXED
+    assert "  3:14: unknown-command: Replace with 'MR' (unsafe)" in result.stderr.splitlines()
+    assert "unsafe fix not made" not in result.stderr
+    assert "MRR" not in result.stdout and result.exit_code == 1  # LED 1 is never fixed
+
+
+@pytest.mark.parametrize("written", ["XM 1, WG 2", "MQ 5000", "MS 100"])
+def test_a_command_guessed_by_its_spelling_is_never_a_safe_fix(tmp_path, written):
+    """`XM 1` (a condition? a call?) became `EM 1`, `WG 2` a 2 ms wait, `MQ 5000` a filter
+    setting: another command changes what the program does, so --fix leaves it."""
+    text = f"target C-863\nautostart {{\n    {written}\n}}\n"
+    f = _write(tmp_path / "t.mcm", text)
+    result = cli("check", "--fix", f)
+    assert f.read_text() == text and result.exit_code == 1
+    assert "unsafe fix" in result.stderr and "--unsafe-fixes" in result.stderr
+
+
+def test_unsafe_fixes_alone_is_a_usage_error(tmp_path):
+    f = _write(tmp_path / "a.mcm", CLEAN)
+    result = cli("check", "--unsafe-fixes", f)
+    assert result.exit_code == 2 and "--unsafe-fixes goes with --fix or --diff" in result.stderr
 
 
 def test_a_file_fixed_clean_exits_0_and_later_checks_find_nothing(tmp_path):
@@ -143,7 +172,7 @@ def test_the_settings_model_is_the_target_added(tmp_path):
 def test_diff_prints_the_fixes_and_writes_nothing(tmp_path):
     f = _write(tmp_path / "jog.mcm", BROKEN)
     before = os.stat(f)
-    result = cli("check", "--diff", f)
+    result = cli("check", "--diff", "--unsafe-fixes", f)
     assert f.read_text() == BROKEN and os.stat(f).st_mtime_ns == before.st_mtime_ns
     assert result.exit_code == 1  # a file would change, as `fmt --diff` says it
     assert result.stdout.startswith(f"--- {f}\n+++ {f}\n@@")
@@ -163,7 +192,7 @@ def test_diff_of_files_with_nothing_to_fix_is_empty_and_exits_0(tmp_path):
 
 
 def test_diff_reads_standard_input_and_fix_refuses_it():
-    result = cli("check", "--diff", "-", input="macro a { MRR 5 }\n")
+    result = cli("check", "--diff", "--unsafe-fixes", "-", input="macro a { MRR 5 }\n")
     assert "+macro a { MR 5 }" in result.stdout and result.exit_code == 1
     refused = cli("check", "--fix", "-", input="macro a { MRR 5 }\n")
     assert refused.exit_code == 2 and refused.stdout == ""
@@ -174,15 +203,18 @@ def test_json_output_stays_json_and_holds_what_remains(tmp_path):
     f = _write(tmp_path / "jog.mcm", BROKEN)
     result = cli("check", "--fix", "--output-format", "json", f)
     remaining = json.loads(result.stdout)["diagnostics"]
-    assert [(d["rule"], d["line"]) for d in remaining] == [("unknown-command", 4),
+    assert [(d["rule"], d["line"]) for d in remaining] == [("unknown-command", 3),
+                                                           ("unknown-command", 4),
                                                            ("unreachable-macro", 6)]
+    assert [d.get("fix", {}).get("applicability") for d in remaining] == [
+        "unsafe", "display-only", None]
     assert "fixed" in result.stderr
 
 
 def test_each_file_of_a_folder_is_fixed_and_counted(tmp_path):
     _write(tmp_path / "a.mcm", BROKEN)
     _write(tmp_path / "b.mcm", CLEAN)
-    result = cli("check", "--fix", tmp_path)
+    result = cli("check", "--fix", "--unsafe-fixes", tmp_path)
     assert (tmp_path / "a.mcm").read_text() == FIXED and (tmp_path / "b.mcm").read_text() == CLEAN
     assert result.stderr.splitlines()[-1] == "1 file fixed (5 fixes), 1 file left unchanged"
 
@@ -205,7 +237,7 @@ def test_undecodable_bytes_are_named_and_the_file_left_as_it_was(tmp_path):
     data = b"// caf\x81\nmacro a { MRR 5 }\n"
     f = tmp_path / "a.mcm"
     f.write_bytes(data)
-    result = cli("check", "--fix", f)
+    result = cli("check", "--fix", "--unsafe-fixes", f)
     assert f.read_bytes() == data and result.exit_code == 2
     assert "byte 0x81 at line 1, column 7" in result.stderr and "not fixed" in result.stderr
     assert "unknown command 'MRR'" in result.stdout
@@ -247,7 +279,8 @@ def test_the_same_fix_twice_is_made_once_and_an_insertion_before_a_replacement_b
 def test_a_process_fixes_the_words_and_keeps_every_other_byte(tmp_path, encoding, bom, end):
     text = "// MMCRun\u2122 export\n" + BROKEN.split("\n", 1)[1]
     f = _write(tmp_path / "jog.mcm", text, end=end, encoding=encoding, bom=bom)
-    done = mercmac_process("check", "--fix", "--target", "C-863", str(f), cwd=tmp_path)
+    done = mercmac_process("check", "--fix", "--unsafe-fixes", "--target", "C-863", str(f),
+                           cwd=tmp_path)
     expected = "// MMCRun\u2122 export\ntarget C-863\n" + FIXED.split("\n", 1)[1]
     assert f.read_bytes() == bom + expected.replace("\n", end).encode(encoding)
     assert done.returncode == 1, done.stderr
@@ -256,7 +289,41 @@ def test_a_process_fixes_the_words_and_keeps_every_other_byte(tmp_path, encoding
 
 def test_a_process_diff_writes_nothing_and_applies_as_the_fix(tmp_path):
     f = _write(tmp_path / "jog.mcm", BROKEN)
-    done = mercmac_process("check", "--diff", str(f), cwd=tmp_path)
+    done = mercmac_process("check", "--diff", "--unsafe-fixes", str(f), cwd=tmp_path)
     assert done.returncode == 1 and f.read_text() == BROKEN
     hunk = done.stdout.splitlines()[3:]  # one hunk: the whole file
     assert [line[1:] for line in hunk if not line.startswith("-")] == FIXED.splitlines()
+
+
+# -- the applicability in the outputs for programs ----------------------------------------------
+
+def test_json_and_sarif_carry_each_fix_with_its_applicability(tmp_path):
+    f = _write(tmp_path / "a.mcm", "macro scan { TP }\nautostart { call scna, XM 1 }\n")
+    found = json.loads(cli("check", "--format", "json", f).stdout)["diagnostics"]
+    (fixed, guessed) = [d for d in found if "fix" in d]
+    assert fixed["fix"] == {"applicability": "safe", "message": "Replace with 'scan'",
+                            "edits": [{"content": "scan", "line": 2, "column": 18,
+                                       "end_line": 2, "end_column": 22}]}
+    assert guessed["fix"]["applicability"] == "unsafe"
+    results = json.loads(cli("check", "--format", "sarif", f).stdout)["runs"][0]["results"]
+    (safe,), (unsafe,) = (r["fixes"] for r in results if "fixes" in r)
+    assert safe["properties"] == {"applicability": "safe"}
+    assert safe["artifactChanges"][0]["replacements"] == [{
+        "deletedRegion": {"startLine": 2, "startColumn": 18, "endLine": 2, "endColumn": 22},
+        "insertedContent": {"text": "scan"}}]
+    assert unsafe["properties"] == {"applicability": "unsafe"}
+    assert unsafe["description"] == {"text": "Replace with 'XF'"}
+
+
+@pytest.mark.parametrize("text, applicability", [
+    ("macro scan { TP }\nautostart { call scna }\n", "safe"),  # the one macro that near
+    ("macro scan { TP }\nmacro scab { TP }\nautostart { call sca }\n", "unsafe"),  # two
+    ("const FAST = 5\nconst FIST = 6\nautostart { SV FEST }\n", "unsafe"),
+    ("const FAST = 5\nautostart { SV FST }\n", "safe"),
+    ("autostart { whne 1 { TP } }\n", "safe"),
+])
+def test_a_name_or_keyword_is_safe_only_with_one_candidate(tmp_path, text, applicability):
+    f = _write(tmp_path / "a.mcm", text)
+    (fixable,) = [d for d in json.loads(cli("check", "--format", "json", f).stdout)["diagnostics"]
+                  if "fix" in d]
+    assert fixable["fix"]["applicability"] == applicability

@@ -58,3 +58,18 @@ async def test_the_target_of_a_document_of_one_comment_goes_on_a_line_of_its_own
     actions = await _actions(client, text)
     add = next(a for a in actions if a.title == "Add `target C-863`")
     assert _apply(text, add.edit.changes[URI][0]) == "// only a comment\ntarget C-863\n"
+
+
+@pytest.mark.asyncio
+async def test_every_fix_is_offered_and_each_but_the_safe_says_what_it_is(
+        client: LanguageClient):
+    """A safe fix is preferred; a guess (another command) and a suggestion that `check --fix`
+    never makes are offered too, their titles saying so (docs/editors.md)."""
+    text = "macro scan { TP }\nautostart { call scna, XM 1, LED 2 }\n"
+    actions = [a for a in await _actions(client, text) if a.kind == t.CodeActionKind.QuickFix]
+    offered = {a.title: a.is_preferred for a in actions}
+    assert offered == {
+        "Replace with 'scan'": True,
+        "Replace with 'XF' (unsafe: a guess, check what it changes)": False,
+        "Replace with 'CN' (suggestion: check --fix never makes it)": False,
+    }
