@@ -127,12 +127,18 @@ class VirtualController:
     def power_on(self, now: float) -> None:
         """Deselected, defaults restored, macro 0 started if stored (MS176E §3.1, §3.8.5)."""
         self._run(now)
+        self._safely("power-on", self.machine.power_on)
+        self._self_select()
+
+    def _restarted(self) -> None:
+        """The front end after power-on or RT, which restarts the firmware "as if from a
+        power-off condition" (MS176E §6.4 RT): deselected, on a chain or alone, since "After
+        power-on or reset, a Mercury controller is not addressed" (§3.1); no line half read
+        and none for a bare CR to repeat."""
         self.selected, self._awaiting_address = False, False
         self._line.clear()
         self._overflow = False
         self._last_line = None
-        self._safely("power-on", self.machine.power_on)
-        self._self_select()
 
     def tick(self, now: float) -> None:
         """Let running macros advance to wall time `now` (seconds since power-on), and read
@@ -190,6 +196,7 @@ class VirtualController:
 
     def report(self, text: str) -> None:
         """Send a report if selected; deselected controllers stay silent (MS176E §5.1, §5.6)."""
+        self._self_select()  # macro 0 may report in the very run of the RT that deselected it
         if self.selected and not self.faults.silent:
             self._out += text.encode("latin-1") + REPORT_END
 
@@ -228,7 +235,10 @@ class VirtualController:
             log.error(message, exc_info=log.isEnabledFor(logging.DEBUG))
 
     def _self_select(self) -> None:
-        """SCn in the autostart macro selects the controller (MS176E §3.1.2)."""
+        """A restart deselects the controller (MS176E §3.1); then SCn in the autostart macro
+        selects it (§3.1.2: "self-addressing at power-on", which RT repeats, §6.4 SC)."""
+        if self.machine.take_restart():
+            self._restarted()
         if self.machine.take_self_select() == self.address:
             self.selected = True
 
@@ -324,6 +334,7 @@ class VirtualController:
         self.lines.append(text)
         self._settle_until = now + SETTLE_CYCLES * self.machine.cycle_ms / 1000
         self._safely(f"the line {text[:40]!r}", self._command, mdtext.canonical(text), now)
+        self._self_select()  # an RT in it: the bytes after it find the controller deselected
         self._save()
 
     def _command(self, line: str, now: float) -> None:

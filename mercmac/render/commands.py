@@ -58,6 +58,8 @@ def facts(c: Command) -> list[tuple[str, str]]:
     if c.mnemonic in _CONSTRUCTS:
         said.append(("in a .mcm file", _CONSTRUCTS[c.mnemonic]))
     said.append(("manual", c.section))
+    for reading in c.readings:  # where mercmac chose between readings of the manual
+        said += [("the manual", reading.manual), ("mercmac's choice", reading.mercmac)]
     return said
 
 

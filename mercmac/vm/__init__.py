@@ -6,7 +6,7 @@
     .run_until(t_ms) .set_input(n, on) .running .now_ms .macro .position() .target
     .velocity() .outputs_pattern() .status() .snapshot() .error
     for applications (emulator, scenarios, the box): .stored_macros() .setting(name)
-    .set_error(code) .take_self_select() .moving() .label .input(n) .input_lines()
+    .set_error(code) .take_restart() .take_self_select() .moving() .label .input(n) .input_lines()
     .now_us .cycle_ms; Options(firmware=...) is the version VE reports
 
 Report strings live in `mercmac.vm.reports`.

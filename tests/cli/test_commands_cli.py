@@ -102,6 +102,30 @@ def test_explain_cn_names_the_led_range_and_section():
     assert "LED n" in out and "range: 1..4" in out and "MS176E §6.4, p. 48" in out
 
 
+@pytest.mark.parametrize("mnemonic, manual, chosen", [
+    # §6.4 RP: "repeats indefinitely"; §3.8.6: RP,RP "more than 4 billion times"
+    ("RP", ['"repeats indefinitely"', "§3.8.6", "more than 4 billion"],
+     ["RP65535", "65,536 times", "2^32"]),
+    ("WA", ['"0 < n < 65,535"'], ["0-65,535 is accepted", "1-65,534"]),  # §6.4 WA heading
+    ("SJ", ["§6.4 SJ", "§3.6.2"], ["-1024 to 1024"]),
+    ("TS", ["§6.4 TS"], ["clears it to 00"]),
+])
+def test_explain_says_which_reading_of_the_manual_mercmac_took(mnemonic, manual, chosen):
+    out = cli("explain", mnemonic).output
+    said = out.split("the manual: ", 1)[1]
+    assert all(text in said.split("\n")[0] for text in manual), out
+    taken = said.split("mercmac's choice: ", 1)[1].split("\n")[0]
+    assert all(text in taken for text in chosen), out
+    assert "mercmac's choice: " in command_help(mnemonic)  # the editor's hover says it too
+
+
+def test_every_reading_cites_the_manual_and_commands_without_one_say_none():
+    for c in COMMANDS.values():
+        for reading in c.readings:
+            assert "§" in reading.manual and reading.mercmac, c.mnemonic
+    assert "the manual: " not in cli("explain", "MR").output  # MR: the manual says one thing
+
+
 def test_explain_still_explains_rules():
     assert "§3.8.4" in cli("explain", "MM011").output
     assert cli("explain", "nested-call").output == cli("explain", "MM011").output
@@ -128,8 +152,8 @@ def test_explain_a_natural_guess(word, says):
 
 
 @pytest.mark.parametrize("word, hint", [("xyzzy", "`mercmac commands`"),
-                                        ("nestedcall", "did you mean nested-call?"),
-                                        ("nested", "did you mean nested-call?"),
+                                        ("nestedcall", "did you mean 'nested-call'?"),
+                                        ("nested", "did you mean 'nested-call'?"),
                                         ("", "`mercmac commands`"),
                                         ("9" * 5000, "`mercmac commands`")])
 def test_explain_an_unknown_word(word, hint):

@@ -104,6 +104,11 @@ FINDS = [
     ("undefined-name", "macro a { SV FAST }\n", None),
     ("undefined-name", "autostart { repeat N { TP } }\n", None),
     ("duplicate-name", "const A = 1\nconst A = 2\n", None),
+    # a when reads its inputs once per pass of its loop (MS176E §6.4 XN)
+    ("slow-poll", "autostart { every 500ms { when 1 { CN 1 } } }\n", None),
+    ("slow-poll", "macro p { WA 100 }\nautostart { repeat 3 { MR 9, WS 200, call p, when 2 { CF 1 } } }\n",
+     None),
+    ("slow-poll", "[MC00] EM1,WA300,RP\n[MC01] XN1,CN1\n", None),
 ]
 
 # (rule, snippet, target): snippets that must NOT raise the rule.
@@ -137,6 +142,12 @@ CLEAN = [
     ("default-argument", "[MC01] WS100,RP5,DI0,DH,TC,FE\n", None),
     ("unreachable-macro", "[MC01] TP\n[MC02] TT\n", None),
     ("contradictory-condition", "[MC01] XN1,XF2,TP\n", None),
+    # 250 ms is a quick press; a when block's own waits run only while it is pressed
+    ("slow-poll", "autostart { every 250ms { when 1 { CN 1 } } }\n", None),
+    ("slow-poll", "autostart { every 20ms { when 1 { MR 9, WS 900, WA 900 } } }\n", None),
+    ("slow-poll", "autostart { every 900ms { CN 1, CF 1 } }\n", None),  # no when: nothing read
+    ("slow-poll", "[MC00] EM1,WA20,RP,RP\n[MC01] XN1,MR5,WA900\n", None),  # Example 4's way
+    ("slow-poll", "[MC00] EM1,WA900,RP0\n[MC01] XN1,CN1\n", None),  # RP0 repeats nothing
 ]
 
 

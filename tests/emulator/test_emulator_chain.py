@@ -105,6 +105,35 @@ def test_two_self_selected_controllers_are_a_collision_in_the_log(tmp_path):
     assert "several controllers answered at once" in log_path.read_text()
 
 
+def test_rt_deselects_the_controller_as_power_on_does():
+    # §3.1: "After power-on or reset, a Mercury controller is not addressed (deselected)";
+    # §6.4 RT restarts it "as if from a power-off condition"
+    with served(VirtualController(address=0), VirtualController(address=1)) as (server, _), \
+            raw_port(server) as port:
+        port.write(select(1) + b"RT\rTB\r")
+        assert read_for(port, 0.3) == b""  # the TB after the RT finds nobody selected
+        assert server.call(lambda c: [vc.selected for vc in c.controllers]) == [False, False]
+        port.write(b"\r")
+        assert read_for(port, 0.3) == b""  # nor does a bare CR repeat the RT or the TB
+        assert answers(port, select(1) + b"TB\r") == [b"B:1" + END]  # selected again
+
+
+@pytest.mark.parametrize("macro_0, heard", [
+    ("WA5,TP", []),  # macro 0 runs after the RT, its report suppressed (§5.1)
+    ("SC3,TP", [b"P:+0000000000" + END]),  # §3.1.2: SC in macro 0 selects it at power-on
+])
+def test_rt_on_a_single_controller_deselects_it_unless_macro_0_selects_it(macro_0, heard):
+    with served(VirtualController(address=3, macros={0: macro_0})) as (server, _), \
+            raw_port(server) as port:
+        port.write(select(3) + b"AB\r")  # AB: its macro 0 stops, but selection stays
+        assert eventually(server, lambda c: not c.by_address(3).running)
+        read_for(port, 0.3)  # what macro 0 said at power-on, if it was selected
+        port.write(b"RT\r")
+        assert eventually(server, lambda c: c.by_address(3).lines[-1] == "RT")
+        assert read_for(port, 0.5) == b"".join(heard)
+        assert server.call(lambda c: c.by_address(3).selected) == bool(heard)
+
+
 def test_a_chain_needs_distinct_addresses():
     with pytest.raises(ValueError, match="distinct"):
         chain.Chain([VirtualController(address=1), VirtualController(address=1)])

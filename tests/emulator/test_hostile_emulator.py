@@ -164,7 +164,8 @@ def test_random_input_never_kills_it_and_keeps_the_macros(chunks):
 @needs_pty
 def test_over_a_pty_bad_arguments_and_endless_lines_leave_it_serving():
     with serve(macros=dict(STORED)) as (server, vc), raw_port(server) as port:
-        port.write(SELECT + b"RT\rXN99\rCN0\rMD7,XN99\rEM7\r")
+        # RT deselects (MS176E §3.1), so the host selects the controller again after it
+        port.write(SELECT + b"RT\r" + SELECT + b"XN99\rCN0\rMD7,XN99\rEM7\r")
         port.write(b"MR5" + b"0" * 100_000)
         port.write(b"\rTS\r")
         assert protocol.parse_status(read_for(port, 0.5).decode()).error == 0x02

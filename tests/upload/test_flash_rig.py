@@ -216,6 +216,10 @@ def test_reset_starts_every_macro_0_once_all_are_verified(rig, data_dir):
         flash_chain(server.path, str(rig), timing=FAST_TIMING, options=FlashOptions(reset=True))
         # the emulator reads the last RT in its own thread
         assert eventually(server, lambda _c: all(vc.running for vc in vcs))
+        # RT deselects (MS176E §3.1): so each RT had its own selection code before it
+        assert not server.call(lambda c: c.selected())
+        again = flash_chain(server.path, str(rig), timing=FAST_TIMING)
+        assert again.changes_nothing  # the next flash selects each again and reads it back
     assert log.getvalue().count("52 54 0d") == 2  # 'RT<CR>', once to each (MS176E §6.4 RT)
 
 

@@ -101,6 +101,9 @@ def test_reset_starts_macro_0(tmp_path):
         run_flash(server, program_of("[MC00] WA5000\n"), tmp_path, reset=True)
         assert eventually(server, lambda _c: vc.lines[-1] == "RT")
         assert server.call(lambda _c: vc.running)  # macro 0 runs after RT (MS176E §6.4 RT)
+        assert not server.call(lambda _c: vc.selected)  # and RT deselected it (§3.1)
+        again, _ = run_flash(server, program_of("[MC00] WA5000\n"), tmp_path)
+        assert again.plan.changes_nothing  # the next flash selects it again and reads it back
 
 
 def test_byte_goals_of_the_benchmark(capsys):
