@@ -25,6 +25,7 @@ from typing import NamedTuple
 
 from mercmac.commands import MODELS
 from mercmac.errors import SettingsError
+from mercmac.suggest import did_you_mean, suggest
 
 KEYS = ("target", "select", "ignore")
 # Only a pyproject.toml that names mercmac is parsed: the others cost one read and no TOML
@@ -145,7 +146,7 @@ def _parse(path: str, table: dict, where: str = "") -> Settings:
     if unknown:
         keys = ", ".join(reprlib.repr(k) for k in unknown[:5]) + (", ..." if unknown[5:] else "")
         raise SettingsError(f"unknown setting{'s' if len(unknown) > 1 else ''} "
-                            f"{keys} in {where}{path}",
+                            f"{keys} in {where}{path}{_meant(unknown[:5])}",
                             hint=f"mercmac knows {', '.join(KEYS)}")
     target = table.get("target")
     if target is not None and (not isinstance(target, str) or target.upper() not in MODELS):
@@ -154,6 +155,17 @@ def _parse(path: str, table: dict, where: str = "") -> Settings:
     return Settings(path, target.upper() if target else None,
                     _rule_list(table, "select", path, where),
                     _rule_list(table, "ignore", path, where))
+
+
+def _meant(unknown: list[str]) -> str:
+    """What a message of unknown keys ends with where they look misspelt (mercmac.suggest):
+    "; did you mean 'select'?", or for several "; did you mean 'select' for 'slect', ...?"."""
+    if len(unknown) == 1:
+        said = did_you_mean(unknown[0], KEYS)
+        return f"; {said}" if said else ""
+    meant = [(key, suggest(key, KEYS)) for key in unknown]
+    pairs = [f"'{near}' for {reprlib.repr(key)}" for key, near in meant if near]
+    return f"; did you mean {', '.join(pairs)}?" if pairs else ""
 
 
 def _rule_list(table: dict, key: str, path: str, where: str) -> tuple[str, ...] | None:

@@ -115,11 +115,12 @@ class McmLexer(RegexLexer):
             (NAME, Name.Constant, "#pop"),
             default("#pop"),
         ],
-        # A native command's argument, on its line: `MR 5000`, `MR5000`, `SV FAST`.
+        # A native command's argument, on its line: `MR 5000`, `MR5000`, `SV FAST`, `MR -FAR`.
         "argument": [
             (r"[ \t]+", Whitespace),
             (INT, Number.Integer, "#pop"),
             (NAME, Name.Constant, "#pop"),
+            (rf"([+-])([ \t]*)({NAME})", bygroups(Operator, Whitespace, Name.Constant), "#pop"),
             default("#pop"),
         ],
     }
@@ -135,11 +136,12 @@ def _alternation() -> str:
 def textmate() -> dict:
     """The TextMate grammar (scope source.mcm): the lexer's rules in Oniguruma's syntax."""
     known = rf"(?<![A-Za-z0-9_.?])(?i:{_alternation()})(?![A-Za-z?])"
-    argument = rf"(?:[ \t]*(?:({INT})|({NAME})))?"
+    argument = rf"(?:[ \t]*(?:({INT})|(?:([+-])[ \t]*)?({NAME})))?"  # `MR -FAR`: a signed const
     command = {"match": rf"({known}){argument}",
                "captures": {"1": {"name": "support.function.mnemonic.mcm"},
                             "2": {"name": "constant.numeric.integer.mcm"},
-                            "3": {"name": "variable.other.constant.mcm"}}}
+                            "3": {"name": "keyword.operator.sign.mcm"},
+                            "4": {"name": "variable.other.constant.mcm"}}}
     unknown = {"match": rf"(?<![A-Za-z0-9_.?]){WORD}", "name": "invalid.illegal.unknown-command.mcm"}
     number = {"match": rf"(?<![A-Za-z0-9_.])(?:{INT})", "name": "constant.numeric.integer.mcm"}
     comment = {"match": COMMENT, "name": "comment.line.double-slash.mcm"}

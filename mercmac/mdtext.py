@@ -36,9 +36,9 @@ BLANKS = " \t\f\v\r\n"
 
 _BLANK = re.compile(r"[ \t\f\v\r\n]+")
 _COMPACT = re.compile(r"([A-Za-z]+\??)([+-]?[0-9]+)?")  # one command, blanks dropped
-# One command as written (grammar.lark's MNEMONIC, then an INT or a NAME)
+# One command as written (grammar.lark's MNEMONIC, then an INT, a NAME or a SIGNED_NAME)
 _WRITTEN = re.compile(r"[ \t\f\v]*([A-Za-z]+\??)[ \t\f\v]*(?:([+-][ \t\f\v]*[0-9]+|[0-9]+)"
-                      r"|([A-Za-z_][A-Za-z0-9_.]*))?[ \t\f\v]*")
+                      r"|((?:[+-][ \t\f\v]*)?[A-Za-z_][A-Za-z0-9_.]*))?[ \t\f\v]*")
 _NUMBER = re.compile(r"[+-]?[0-9]+")
 
 
@@ -184,7 +184,7 @@ def _as_written(piece: str, at: int, chars: list[int]) -> Written | Problem:
     if m.end() < len(piece):
         return _unexpected(piece, at, m.end(), lookup(m.group(1)))
     number_text, name = m.group(2), m.group(3)
-    value = _value(number_text) if number_text else name
+    value = _value(number_text) if number_text else name and _BLANK.sub("", name)  # `- FAR`
     value_group = 2 if number_text else 3 if name else 1
     value_start = m.start(value_group) if value is not None else m.end(1)
     end = m.end(value_group)

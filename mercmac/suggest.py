@@ -1,7 +1,9 @@
 """'Did you mean ...?': the one measure of how close two words are, and the nearest known word.
 
 Used for mnemonics (mercmac.commands.nearest), macro and const names (compiler/checks.py),
-`mercmac explain` keys and the names of mercmac's own commands (cli).
+`mercmac explain` keys, the names of mercmac's own commands (cli), settings keys
+(mercmac.config) and rig file keys and names (mercmac.rig.load); `did_you_mean` is the phrase
+their messages end with.
 """
 from __future__ import annotations
 
@@ -23,11 +25,12 @@ def distance(a: str, b: str) -> int:
     return row[-1]
 
 
-def suggest(word: str, known: Iterable[str], limit: int) -> str | None:
+def suggest(word: str, known: Iterable[str], limit: int | None = None) -> str | None:
     """The known word nearest to `word`, case aside: the same but for case, else the fewest
-    edits, at most `limit` (ties: the alphabetically first); None when none is that close."""
+    edits, at most `limit` (by default a third of its letters, at least one; ties: the
+    alphabetically first); None when none is that close."""
     low = word.lower()
-    best, best_cost = None, limit
+    best, best_cost = None, max(1, len(word) // 3) if limit is None else limit
     for name in known:
         if abs(len(name) - len(low)) > best_cost:  # the distance is at least that
             continue
@@ -45,3 +48,14 @@ def candidates(word: str, known: Iterable[str], limit: int) -> list[str]:
     near = [(distance(low, name.lower()), name) for name in known
             if abs(len(name) - len(low)) <= limit]
     return [name for cost, name in sorted(near) if cost <= limit]
+
+
+def did_you_mean(word: str, known: Iterable[str], limit: int | None = None) -> str:
+    """"did you mean 'select'?" for the known word nearest to `word` (`suggest`), or "" when
+    none is that near: what a message about an unknown word ends with."""
+    return question(suggest(word, known, limit))
+
+
+def question(meant: str | None) -> str:
+    """"did you mean 'select'?" for the word `meant` instead of the one written; "" for None."""
+    return f"did you mean '{meant}'?" if meant else ""

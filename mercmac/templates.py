@@ -24,9 +24,8 @@ JOG = """\
 // The LED of the active button is lit while it works.
 target $target
 
-const FAR = 9999999   // targets the stage never reaches: the move ends with AB
-const BACK_FAR = -9999999
-const STEP = 1000   // one press of button 4, in counts (C-863) or microsteps (C-663)
+const FAR = 9999999   // targets the stage never reaches: the move ends with AB (MR -FAR back)
+const STEP = 1000     // one press of button 4, in counts (C-863) or microsteps (C-663)
 
 // Velocity and acceleration first, then the motor on (§3.4, §3.5: MN).
 macro setup { SV 50000, SA 200000, MN }
@@ -41,7 +40,7 @@ macro run {
     // held; WF waits for the release, AB stops the run, WS waits until on target.
     every 20ms {
         when 1 and not 2 { CP 1, MR FAR, WF 1, AB 1, CP 0 }
-        when 2 and not 1 { CP 2, MR BACK_FAR, WF 2, AB 1, CP 0 }
+        when 2 and not 1 { CP 2, MR -FAR, WF 2, AB 1, CP 0 }
         when 3 { CP 4, GH, WS 0, CP 0 }
         when 4 { CP 8, MR STEP, WS 10, WF 4, CP 0 }
     }

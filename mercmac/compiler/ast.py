@@ -18,7 +18,16 @@ class Number(NamedTuple):
 
 class Name(NamedTuple):
     name: str
-    span: Span
+    span: Span  # with the sign, if it has one
+    sign: str = ""  # a command's argument may be `-FAR` (the const negated) or `+FAR`
+
+    @property
+    def name_span(self) -> Span:
+        """Where the name itself stands: after its sign and blanks, at the end of the value."""
+        if not self.sign:
+            return self.span
+        s = self.span
+        return Span(s.end_line, s.end_column - len(self.name), s.end_line, s.end_column)
 
 
 class Invalid(NamedTuple):

@@ -129,6 +129,8 @@ def _raw_command(c: mdtext.Written, line: int, at: int) -> ast.Command:
 def _value(tok: Lexeme) -> ast.Value:
     if tok.type == "INT":
         return _number(tok)
+    if tok.type == "SIGNED_NAME":  # `-FAR`, `- FAR`: grammar.lark
+        return ast.Name(tok.value[1:].lstrip(" \t"), tok.span, tok.value[0])
     return ast.Name(tok.value, tok.span)
 
 

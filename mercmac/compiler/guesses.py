@@ -54,8 +54,17 @@ _TABLE = (
           "report", (M.TP, M.TT), "MS176E §5.6, §6.4 TP p. 79"),
     Guess(("speed", "velocity"), "write `SV {n}` to set the velocity to {n} counts/s",
           (M.SV,), "MS176E §6.4 SV p. 75"),
-    Guess(("accel", "acceleration"), "write `SA {n}` to set the acceleration to {n} counts/s²",
-          (M.SA,), "MS176E §6.4 SA p. 71"),
+    Guess(("accel", "acceleration", "accelerate"),
+          "write `SA {n}` to set the acceleration to {n} counts/s²", (M.SA,),
+          "MS176E §6.4 SA p. 71"),
+    Guess(("position", "pos"),
+          "`MA {n}` moves to position {n}, `TP` reports the position, and `DH {n}` makes the "
+          "current position {n}", (M.MA, M.TP, M.DH), "MS176E §6.4 MA p. 68, TP p. 79, DH p. 50"),
+    Guess(("trigger", "camera", "shutter"),
+          "output 4 gives trigger pulses to a camera or other device: `ZP p` sets the position "
+          "of the first, `ZI i` the distance to the next, and `ZM m` the mode (1 one pulse, "
+          "2 pulses from ZP every ZI, 3 a pulse every ZI counts, 0 off)",
+          (M.ZM, M.ZP, M.ZI), "MS176E §4.5.2, §6.4 ZM p. 89"),
     Guess(("servo", "motor"), "`MN` switches the motor (servo) on, `MF` off",
           (M.MN, M.MF), "MS176E §6.4 MN p. 69"),
     # -- constructs of the language (docs/language.md) --

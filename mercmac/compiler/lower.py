@@ -23,7 +23,8 @@ from typing import NamedTuple
 from mercmac.commands import Mnemonic
 from mercmac.compiler import ast
 from mercmac.compiler.checks import Env
-from mercmac.compiler.program import MAX_COMMANDS, SLOTS, Macro, Program, rp_counts, wait_pieces
+from mercmac.compiler.program import (MAX_COMMANDS, SLOTS, Macro, Program, as_written, rp_counts,
+                                      wait_pieces)
 from mercmac.diagnostics import Report
 from mercmac.mdtext import slot_name
 from mercmac.ops import Op, Origin, Role
@@ -301,7 +302,8 @@ class _Lowerer:
         if op.mnemonic == Mnemonic.TI and self.loops and self.loops[-1] is not owner \
                 and op.span not in self.warned:
             self.warned.add(op.span)
-            self.report.add("ti-moved", op.span, owner=owner.name, loop=self.loops[-1].name)
+            self.report.add("ti-moved", op.span, owner=as_written(owner.name),
+                            loop=as_written(self.loops[-1].name))
         line.ops.append(op)
 
     def call(self, stmt: ast.Call, line: _Line) -> None:
@@ -536,7 +538,7 @@ class _Lowerer:
             if m.slot is None:
                 m.slot = next(free, None)
                 if m.slot is None:
-                    self.report.add("slot-range", m.span, "full", name=m.name,
+                    self.report.add("slot-range", m.span, "full", name=as_written(m.name),
                                     count=len(self.order))
                     continue
                 taken[m.slot] = m

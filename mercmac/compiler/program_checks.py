@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from mercmac.commands import Mnemonic
 from mercmac.compiler.program import MAX_COMMANDS, Macro, Program
+from mercmac.compiler.sampling import check_raw_loop
 from mercmac.ops import USER_ORIGINS, Op, Origin, Role
 from mercmac.diagnostics import Report, Severity
 
@@ -21,15 +22,19 @@ def check_program(program: Program, report: Report) -> None:
         _length(m, report)
         _placement(m, report)
         _contradictions(m, report)
+        calls = False
         for i, op in enumerate(m.ops):
             if op.mnemonic == Mnemonic.EM:
                 _call(program, m, i, op, report)
+                calls = True
+        if calls and m.origin is Origin.RAW:  # a raw loop polls through the macros it calls
+            check_raw_loop(program, m, report)
     _reachability(program, report)
 
 
 def _length(m: Macro, report: Report) -> None:
     if m.origin == Origin.RAW and len(m.ops) > MAX_COMMANDS:
-        report.add("too-many-commands", m.span, macro=m.label, count=len(m.ops),
+        report.add("too-many-commands", m.span, macro=m.written, count=len(m.ops),
                    max=MAX_COMMANDS)
 
 
@@ -37,7 +42,7 @@ def _placement(m: Macro, report: Report) -> None:
     for i, op in enumerate(m.ops):
         if op.mnemonic == Mnemonic.SC and m.slot != 0:
             moved = "" if m.origin in USER_ORIGINS else "moved"
-            report.add("sc-outside-autostart", op.span or m.span, moved, macro=m.label)
+            report.add("sc-outside-autostart", op.span or m.span, moved, macro=m.written)
         if op.role == Role.GOTO and i != len(m.ops) - 1:
             report.add("goto-not-last", op.span or m.span, "loop")
 
@@ -49,7 +54,7 @@ def _contradictions(m: Macro, report: Report) -> None:
             continue
         other = seen.get((Mnemonic.XF if op.mnemonic == Mnemonic.XN else Mnemonic.XN, op.arg))
         if other is not None:
-            report.add("contradictory-condition", op.span or m.span, macro=m.label,
+            report.add("contradictory-condition", op.span or m.span, macro=m.written,
                        input=op.arg, first=other.text, second=op.text)
         seen.setdefault((op.mnemonic, op.arg), op)
 
@@ -67,7 +72,7 @@ def _call(program: Program, caller: Macro, index: int, op: Op, report: Report) -
     chain = _goto_chain(program, callee) if op.role == Role.CALL else None
     if chain:
         report.add("nested-call", op.span or caller.span, "goto", severity=Severity.ERROR,
-                   caller=caller.label, callee=callee.label, chain=" -> ".join(chain),
+                   caller=caller.written, callee=callee.written, chain=" -> ".join(chain),
                    rest=",".join(o.text for o in remainder))
         return
     if _returns(program, callee, remainder):
@@ -75,10 +80,12 @@ def _call(program: Program, caller: Macro, index: int, op: Op, report: Report) -
     inner = program.macros[next(o.arg for o in callee.ops
                                 if o.mnemonic == Mnemonic.EM and o.arg in program.macros)]
     raw = op.role == Role.RAW  # on raw blocks the manual's own way of switching modes
-    report.add("nested-call", op.span or caller.span, "" if raw else _advice(op, inner),
-               severity=Severity.WARNING if raw else Severity.ERROR, caller=caller.label,
-               callee=callee.label, inner=inner.label, rest=",".join(o.text for o in remainder),
-               max=MAX_COMMANDS)
+    report.add("nested-call", op.span or caller.span,
+               "" if raw else _advice(op, caller, inner),
+               severity=Severity.WARNING if raw else Severity.ERROR, caller=caller.written,
+               callee=callee.written, inner=inner.written, rest=",".join(o.text for o in remainder),
+               max=MAX_COMMANDS, target=inner.name, loop=caller.name,
+               line=_loop_line(remainder, caller))
 
 
 def _returns(program: Program, callee: Macro, remainder: list[Op]) -> bool:
@@ -118,7 +125,7 @@ def _ends_on_purpose(program: Program, macro: Macro, then: int | None) -> bool:
 def _goto_chain(program: Program, callee: Macro) -> list[str] | None:
     """The path from a called macro to a goto it may run ('g (MC01) -> goto m (MC02)'),
     through the macros the compiler made of its blocks; None when it has none."""
-    seen, todo = {callee.slot}, [(callee, [callee.label])]
+    seen, todo = {callee.slot}, [(callee, [callee.written])]
     while todo:
         macro, path = todo.pop(0)
         for o in macro.ops:
@@ -126,18 +133,35 @@ def _goto_chain(program: Program, callee: Macro) -> list[str] | None:
             if target is None:
                 continue
             if o.role == Role.GOTO:
-                return path + [f"goto {target.label}"]
+                return path + [f"goto {target.written}"]
             if o.role in (Role.HOIST, Role.CONTINUE) and target.slot not in seen:
                 seen.add(target.slot)
-                todo.append((target, path + [target.label]))
+                todo.append((target, path + [target.written]))
     return None
 
 
-def _advice(op: Op, inner: Macro) -> str:
+def _advice(op: Op, caller: Macro, inner: Macro) -> str:
     """The `nested-call` message variant that says what to do about it."""
     if inner.origin == Origin.PART:
         return "split"  # the callee was chained into parts
-    return "call" if op.role == Role.CALL else "loop"
+    if op.role == Role.CALL:
+        return "call"
+    # A when block hoisted out of a loop (the only hoisted block with code after its EM):
+    # the pattern that works is goto the work and goto back to the loop's macro, which
+    # the user can name only if the loop starts a macro of theirs (docs/language.md).
+    return _LOOP_ADVICE[inner.origin == Origin.MACRO, caller.origin == Origin.MACRO]
+
+
+# (the work is a macro of the user's, the loop starts a macro of theirs) -> variant
+_LOOP_ADVICE = {(True, True): "loop", (False, True): "loop-block",
+                (True, False): "loop-unnamed", (False, False): "loop-block-unnamed"}
+
+
+def _loop_line(remainder: list[Op], caller: Macro) -> int | None:
+    """The line of the innermost loop around a block: its RP is the first after the block's EM."""
+    rp = next((o for o in remainder if o.mnemonic == Mnemonic.RP and o.span), None)
+    span = rp.span if rp else caller.span
+    return span.line if span else None
 
 
 def _reachability(program: Program, report: Report) -> None:
@@ -151,4 +175,4 @@ def _reachability(program: Program, report: Report) -> None:
                 todo.append(op.arg)
     for m in program.macros.values():
         if m.slot not in seen and m.origin in USER_ORIGINS and m.name not in program.inlined:
-            report.add("unreachable-macro", m.span, macro=m.label)
+            report.add("unreachable-macro", m.span, macro=m.written)

@@ -18,7 +18,7 @@ ALIGN_WIDTH = 100
 
 _BLANKS = re.compile(r"[ \t\f\v]+")
 # Tokens written with their blanks dropped; MNEMONIC and MODEL also upper case.
-_SQUEEZE = {"INT", "DURATION", "MNEMONIC", "MODEL"}
+_SQUEEZE = {"INT", "SIGNED_NAME", "DURATION", "MNEMONIC", "MODEL"}
 _UPPER = {"MNEMONIC", "MODEL"}
 _NO_SPACE_BEFORE = {"COMMA"}
 _NO_SPACE_AFTER = {"AT"}

@@ -191,7 +191,7 @@ def _tokens(node) -> list:
 
 def _value(value) -> tuple[str, str]:
     if isinstance(value, ast.Name):
-        return ("NAME", value.name)
+        return ("SIGNED_NAME", value.sign + value.name) if value.sign else ("NAME", value.name)
     return ("INT", str(value.value))
 
 

@@ -98,8 +98,8 @@ def _walk(body: tuple, found: list[Use]) -> None:
 
 
 def _value(value, found: list[Use]) -> None:
-    if isinstance(value, ast.Name):
-        found.append(Use("const", value.name, value.span, False))
+    if isinstance(value, ast.Name):  # `-FAR`: the name without its sign, as rename rewrites it
+        found.append(Use("const", value.name, value.name_span, False))
 
 
 def inside(span: Span, line: int, column: int) -> bool:
@@ -169,7 +169,7 @@ def slot_help(slot: int, program: Program | None) -> str:
     macro = program.macros.get(slot)
     if macro is None:
         return head + f"\n\n(empty: no block defines it, so EM{slot} does nothing; MS176E §6.4 EM)"
-    return "\n".join([f"**{macro.label}**: {_ORIGINS[macro.origin]}", "", "```", macro.md,
+    return "\n".join([f"**{macro.written}**: {_ORIGINS[macro.origin]}", "", "```", macro.md,
                       "```", "", _called_by(slot, program)])
 
 
@@ -184,7 +184,7 @@ def _called_by(slot: int, program: Program) -> str:
     """'called by: jog (MC01), MC09' from the EMs of the lowered program."""
     if slot == 0:
         return "runs at power-on and reset: macro 0 is the autostart macro (MS176E §3.8.5)"
-    callers = [m.label for m in program.ordered()
+    callers = [m.written for m in program.ordered()  # a hoisted block by its line
                if any(op.mnemonic == Mnemonic.EM and op.arg == slot for op in m.ops)]
     return "called by: " + (", ".join(callers) if callers else
                             "no macro (only a host's EM runs it)")

@@ -7,7 +7,7 @@ from mercmac.diagnostics import Rule
 from mercmac.errors import InputError
 from mercmac.names import printable
 from mercmac.render.console import Line, write_lines
-from mercmac.vm import hazards
+from mercmac import hazards
 
 _SEVERITY_STYLE = {"error": "bold red", "warning": "bold yellow", "info": "bold cyan"}
 # The checks of `mercmac check` (MMnnn), then the hazards `mercmac sim` reports (MHnnn).
@@ -73,15 +73,14 @@ def _guess_lines(key: str) -> list[Line]:
 def _nearest(key: str) -> str:
     """'did you mean ...?' among the rules and the commands; else where the lists are."""
     from mercmac.commands import COMMANDS
-    from mercmac.suggest import suggest
+    from mercmac.suggest import question, suggest
 
     low = key.lower()
     close = suggest(key, [r.name for r in ALL] + list(COMMANDS), max(1, len(key) // 3)) \
         if len(key) <= _LONGEST else None
     if close is None and len(low) >= 3:  # `nested` for nested-call
         close = next((r.name for r in ALL if low in r.name or r.name in low), None)
-    return (f"did you mean {close}?" if close else
-            "`mercmac explain` lists the rules, `mercmac commands` the commands")
+    return question(close) or "`mercmac explain` lists the rules, `mercmac commands` the commands"
 
 
 def write_rule_list() -> None:

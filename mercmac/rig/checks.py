@@ -134,7 +134,7 @@ class Step(NamedTuple):
     """One command of a program in the order a run meets it first (from macro 0)."""
 
     op: Op
-    macro: str  # its label: 'scan (MC03)'
+    macro: str  # as messages name it: 'scan (MC03)', 'the `when` at line 4 (MC05)'
 
 
 def _ops(checked: Checked) -> list[Step]:
@@ -157,9 +157,10 @@ def _walk(program, slot: int, seen: set[int], steps: list[Step]) -> None:
     while stack:  # iterative: a long chain of macros must not recurse
         slot, at = stack.pop()
         macro = program.macros[slot]
+        label = macro.written  # a hoisted block as the user wrote it: 'the `when` at line 4'
         for i in range(at, len(macro.ops)):
             op = macro.ops[i]
-            steps.append(Step(op, macro.label))
+            steps.append(Step(op, label))
             if op.mnemonic == Mnemonic.EM and op.arg in program.macros and op.arg not in seen:
                 seen.add(op.arg)
                 stack += [(slot, i + 1), (op.arg, 0)]
@@ -378,7 +379,7 @@ def _sure_stop(rig: Rig, checked: Checked) -> _Stop | None:
         op = macro.ops[place.ip]
         if op.mnemonic == Mnemonic.WN:
             by_hand = op.arg in rig.by_hand(name)  # a person may still come: no sure stop
-            return None if by_hand else _Stop(Step(op, macro.label), frozenset(raised))
+            return None if by_hand else _Stop(Step(op, macro.written), frozenset(raised))
         if not _passes(rig, name, op, macro.ops[:place.ip]):
             return None
         raised |= {n for n in range(1, 5) if _sets(op, n)}

@@ -17,7 +17,7 @@ from mercmac.rig import SUFFIX, is_rig_path  # noqa: F401 (is_rig_path: read her
 from mercmac.rig.locate import Places, locate
 from mercmac.rig.model import NAME_MAX, Controller, Line, LineKind, Rig, Wire
 from mercmac.source import Source, Span, read_bytes
-from mercmac.suggest import suggest
+from mercmac.suggest import did_you_mean
 
 TOP_KEYS = ("name", "box", "box_buttons", "wires", "joystick", "controllers")
 CONTROLLER_KEYS = ("address", "model", "program")
@@ -216,18 +216,18 @@ class _Reader:
         """`name` if it is a controller of the rig; else None, reported."""
         if name is None or name in names:
             return name
-        close = suggest(name, sorted(names), max(1, len(name) // 3)) if is_name(name) else None
+        said = did_you_mean(name, sorted(names)) if is_name(name) else ""
         self.report.add("rig-file", span or self.places.of(*path), "unknown-controller",
-                        where=where, name=_shown(name),
-                        hint=f"; did you mean '{close}'?" if close else "")
+                        where=where, name=_shown(name), hint=f"; {said}" if said else "")
         return None
 
     def _known(self, table: dict, keys: tuple[str, ...], path: tuple[str, ...]) -> None:
         where = f"in [{'.'.join(path)}]" if path else "at the top of the rig file"
         for key in table:
             if key not in keys:
+                said = did_you_mean(key, keys)
                 self.report.add("rig-file", self.places.of(*path, key), "unknown", key=key,
-                                where=where, keys=", ".join(keys))
+                                where=where, keys=", ".join(keys), hint=f"{said} " if said else "")
 
     def _typed(self, table: dict, key: str, kind: type, expects: str, default):
         value = table.get(key, default)

@@ -17,6 +17,7 @@ import hashlib
 import json
 import os
 import random
+import re
 from unittest import mock
 
 import pytest
@@ -117,7 +118,8 @@ def outcome(text: str) -> str:
     node's type), the broken lines and the syntax errors."""
     report = Report("t.mcm")
     parsed = _parse_module(text, report)
-    found = [repr(parsed.tree), sorted(parsed.broken), parsed.failed, _diagnostics(report)]
+    tree = repr(parsed.tree).replace(", sign=''", "")  # a name without a sign, as it was
+    found = [tree, sorted(parsed.broken), parsed.failed, _diagnostics(report)]
     return hashlib.sha256(json.dumps(found).encode()).hexdigest()[:16]  # 64 bits: enough
 
 
@@ -144,8 +146,13 @@ def test_golden_outcomes_of_the_reading_before():
     cases = golden_cases(expected["examples"])
     assert set(expected["outcomes"]) == set(cases), "HOSTILE changed: regenerate (see the top)"
     differ = [(name, text[:300]) for name, text in sorted(cases.items())
-              if outcome(text) != expected["outcomes"][name]]
+              if outcome(text) != expected["outcomes"][name] and not _SIGNED_NAME.search(text)]
     assert not differ
+
+
+# Read otherwise on purpose since: a sign before a name is a const's value signed (`MR -FAR`,
+# docs/language.md), where a sign before a letter was a syntax error.
+_SIGNED_NAME = re.compile(r"[+-][ \t]*[A-Za-z_]")
 
 
 def both_readings(text: str):
