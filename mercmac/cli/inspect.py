@@ -152,7 +152,8 @@ def _guarded(work) -> None:
                                              "--rig, replace files DIR holds already.")
 @click.option("--rig", "rig_dir", type=click.Path(file_okay=False), callback=file_name,
               help="With --port: scan the chain and write a rig folder, DIR/NAME.rig.toml and "
-                   "each controller's source (as `pull --rig`, decompiled).")
+                   "each controller's source (as `pull --rig`): the recorded one when "
+                   "`mercmac history` knows its build, else decompiled.")
 def decompile(file, port, address, baud, timeout, output, force, rig_dir) -> None:
     """Turn raw macros back into high-level source that builds to exactly the same macros.
 

@@ -303,8 +303,10 @@ def pull_rig(port: str, folder: Path, baud: int, timeout: float, text_of, *,
              force: bool = False) -> int:
     """Scan PORT, read every controller, write FOLDER/NAME.rig.toml and NAME.mcm for each;
     `text_of(member)`: a controller's .mcm text (stored macros, source, decompiled) and
-    what it is, for the table. Every file is checked before the first is written; one that
-    is there already is replaced only with FORCE (docs/rigs.md), a symlink never."""
+    what it is, for the table. The rig file has the wires, box and joystick of the rig
+    flashed to the chain when that file still matches it (upload.rig.recorded_wiring). Every
+    file is checked before the first is written; one that is there already is replaced only
+    with FORCE (docs/rigs.md), a symlink never."""
     from mercmac import outfile
     from mercmac.render import upload as view
     from mercmac.render.console import write_lines
@@ -316,7 +318,8 @@ def pull_rig(port: str, folder: Path, baud: int, timeout: float, text_of, *,
     name = rig.rig_name(members, folder)
     made = [text_of(m) for m in members]
     texts = {f"{m.name}.mcm": text for m, (text, _) in zip(members, made)}
-    texts[f"{name}.rig.toml"] = rig.rig_text(name, members, port)
+    wiring = rig.recorded_wiring(members)  # read before DIR's own rig file may be replaced
+    texts[f"{name}.rig.toml"] = rig.rig_text(name, members, port, wiring)
     try:
         outfile.fill(folder, texts, replace=force)
     except outfile.Occupied as e:
@@ -325,7 +328,7 @@ def pull_rig(port: str, folder: Path, baud: int, timeout: float, text_of, *,
             from None
     rig_file = folder / f"{name}.rig.toml"
     write_lines(view.pulled_rig_lines(members, port, rig_file, [how for _, how in made],
-                                      _checked(rig_file)), sys.stderr)
+                                      _checked(rig_file), wiring), sys.stderr)
     return EXIT_OK
 
 

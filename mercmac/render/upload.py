@@ -467,17 +467,56 @@ def _rig_style(row) -> str:
 
 
 def pulled_rig_lines(members, port: str, rig_file, how: list[str],
-                     found: list | str) -> list[Line]:
-    """A row per controller read from the chain, what its file holds (`how`), the rig file,
-    and what `check` finds in it as written (`found`: its diagnostics, or why it could not
-    check it)."""
+                     found: list | str, wiring=None) -> list[Line]:
+    """A row per controller read from the chain, what its file holds (`how`) and why, the rig
+    file and where its wiring came from (`wiring`, upload.rig.Wiring), and what `check` finds
+    in it as written (`found`: its diagnostics, or why it could not check it)."""
     rows = [(m.name, str(m.address), m.pulled.identity.version.name,
              plural(len(m.pulled.macros), "macro"), made) for m, made in zip(members, how)]
     lines = table(("controller", "address", "model", "holds", "written as"), rows)
+    lines += _written_as(members, how)
     lines.append([("rig: ", "bold"), (f"{printable(str(rig_file))} ("
                                       f"{plural(len(members), 'controller')} on "
-                                      f"{printable(port)}; wires cannot be read: add them)", "")])
+                                      f"{printable(port)}; {_wired(wiring)})", "")])
     return lines + [_checked_line(rig_file, found)]
+
+
+def _written_as(members, how: list[str]) -> list[Line]:
+    """Why each kind of file was written, naming the controllers: a recorded source is the
+    one mercmac flashed, which builds to exactly what the controller holds (upload.history)."""
+    kinds: dict[str, list] = {}
+    for m, made in zip(members, how):
+        kinds.setdefault(made, []).append(m)
+    lines = []
+    for made, these in kinds.items():
+        names = ", ".join(m.name for m in these)
+        if made == "recorded source":
+            why = ("each holds a build the flash history records (`mercmac history`), so the "
+                   "source flashed comes back, names and comments included: it builds to "
+                   "exactly what the controller holds")
+        elif any(m.record for m in these):  # stored macros although a flash is known: --raw
+            why = "--raw: the macros as the controller stores them"
+        else:
+            holds = "it holds" if len(these) == 1 else "they hold"
+            what = ("made from the stored macros, with made-up names" if made == "decompiled"
+                    else "the macros as stored")
+            why = f"no flash in the history left exactly what {holds}: {what}"
+        lines.append([(f"{made} ", "bold"), (f"({printable(names)}): {why}", "")])
+    return lines
+
+
+def _wired(wiring) -> str:
+    """Where the rig file's wires came from: the rig flashed to the chain, or nowhere."""
+    from mercmac.upload.rig import given_back, wiring_date
+
+    if wiring is None or wiring.rig is None:
+        stale = (f"; the rig flashed on {wiring_date(wiring)}, {printable(wiring.path)}, no "
+                 f"longer matches: {printable(wiring.why)}" if wiring is not None and wiring.why
+                 else "")
+        return f"wires cannot be read: add them{stale}"
+    return (f"{given_back(wiring.rig)} from the rig flashed on {wiring_date(wiring)}: "
+            f"{printable(wiring.path)}")
+
 
 
 def _checked_line(rig_file, found: list) -> Line:

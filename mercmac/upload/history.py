@@ -202,10 +202,16 @@ def _rebuilds(found: Record, wanted: dict[int, str]) -> str:
     compiled = built(found)
     if compiled.program is None or compiled.report.has_errors:
         return "it has errors with this mercmac"
-    lines = {slot: body for slot, body in map(mdtext.split_md, compiled.program.md_lines())}
-    if _normal(lines) != wanted:
+    if not builds_to(compiled.program, wanted):
         return "this mercmac lowers it to other macros"
     return ""
+
+
+def builds_to(program, macros: dict[int, str]) -> bool:
+    """Whether a compiled Program builds to exactly `macros` (slot -> line), each macro as
+    the controller stores it."""
+    lines = {slot: body for slot, body in map(mdtext.split_md, program.md_lines())}
+    return _normal(lines) == _normal(macros)
 
 
 def _normal(macros: dict[int, str]) -> dict[int, str]:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 from mercmac import outfile
 from mercmac.upload import history, survey
@@ -107,6 +107,65 @@ def _named(read: list[tuple[int, survey.Pulled]], port: str, records: list) -> l
     return out
 
 
+class Wiring(NamedTuple):
+    """What a chain's history gives back beyond its programs: the rig file mercmac flashed to
+    it (`path`, read today as `rig`) and its newest flash there (`record`). `rig` is None when
+    no controller holds a build flashed as part of a rig, or when that file no longer matches
+    the chain (`why`): wires, box and joystick cannot be read from the controllers."""
+
+    rig: "Rig | None" = None
+    record: history.Record | None = None
+    path: str = ""
+    why: str = ""
+
+
+def recorded_wiring(members: list[Pulled]) -> Wiring:
+    """The rig file the history says was flashed to these controllers, when it still matches
+    what they hold: it reads and checks without errors, and each of its controllers answered
+    at its address under its name and holds what its program builds to today. Controllers
+    the rig does not name may answer too (they get no wire)."""
+    recorded = [m.record for m in members if m.record is not None and m.record.rig]
+    if not recorded:
+        return Wiring()
+    newest = max(recorded, key=lambda r: r.when)
+    paths = sorted({r.rig for r in recorded})
+    if len(paths) > 1:
+        return Wiring(None, newest, newest.rig, f"the chain holds builds of {len(paths)} rig "
+                                                f"files ({', '.join(paths)})")
+    rig, why = _still_matching(newest.rig, members)
+    return Wiring(rig, newest, newest.rig, why)
+
+
+def _still_matching(path: str, members: list[Pulled]) -> tuple["Rig | None", str]:
+    """The rig file at PATH, read as every command reads a rig, and '' when the chain holds
+    what it says; else None and why not."""
+    from mercmac.errors import MercmacError
+    from mercmac.rig.open import ProgramsUnread, RigRefused, RigUnreadable, accept
+
+    try:
+        accepted = accept(path)
+    except RigUnreadable as e:  # gone, moved, no longer a regular file
+        return None, f"it cannot be read ({e.why})"
+    except ProgramsUnread:
+        return None, "a program it names cannot be read"
+    except RigRefused:
+        return None, "`mercmac check` finds errors in it now"
+    except MercmacError as e:  # a settings file above it that `check` refuses
+        return None, e.message
+    by_address = {m.address: m for m in members}
+    for c in accepted.rig.controllers:
+        m = by_address.get(c.address)
+        if m is None:
+            return None, f"its {c.name} at address {c.address} did not answer"
+        if m.record is None or (m.record.rig, m.record.controller) != (path, c.name) \
+                or m.name != c.name:
+            return None, f"its {c.name} (address {c.address}) holds no build flashed from it"
+        if not history.builds_to(accepted.programs[c.name].program, m.pulled.macros):
+            return None, (f"{os.path.basename(c.program)} no longer builds to what {c.name} "
+                          "holds")
+    return accepted.rig, ""
+
+
 def rig_name(members: list[Pulled], folder: Path) -> str:
     """The rig's name as the history has it, when the records agree on one that is a name
     (a history file may say '../x'); else one made from the folder's name."""
@@ -119,10 +178,11 @@ def rig_name(members: list[Pulled], folder: Path) -> str:
     return name_from(folder.name)
 
 
-def rig_text(name: str, members: list[Pulled], port: str) -> str:
-    """A rig file for the pulled controllers (keys as mercmac.rig.load reads them); what a
-    controller cannot tell (wires, box, joystick) is said in a comment, the port escaped
-    (TOML refuses control characters in a comment, and a newline would end it)."""
+def rig_text(name: str, members: list[Pulled], port: str, wiring: Wiring = Wiring()) -> str:
+    """A rig file for the pulled controllers (keys as mercmac.rig.load reads them); the wires,
+    box and joystick of the rig flashed to them when it still matches (`wiring`), else what a
+    controller cannot tell is said in a comment. Paths and the port are escaped (TOML refuses
+    control characters in a comment, and a newline would end it)."""
     import datetime as _dt
     import json
 
@@ -131,13 +191,51 @@ def rig_text(name: str, members: list[Pulled], port: str) -> str:
 
     when = _dt.datetime.now().astimezone().isoformat(timespec="seconds")
     head = [f"# read by mercmac {__version__} from {printable(port)} on {when}: the "
-            f"controllers that answered a scan",
-            "# Wires cannot be read from controllers (nor which one has the C-170.PB box,",
-            "# nor the joystick's branches): add them, e.g. wires = [\"x.out1 -> y.in1\"]",
-            f"name = {json.dumps(name)}",  # a JSON string is a TOML basic string
-            "wires = []"]
+            f"controllers that answered a scan"]
+    if wiring.rig is None:
+        head += ["# Wires cannot be read from controllers (nor which one has the C-170.PB box,",
+                 "# nor the joystick's branches): add them, e.g. wires = [\"x.out1 -> y.in1\"]"]
+        if wiring.why:
+            head.append(f"# (the rig flashed on {wiring_date(wiring)}, {printable(wiring.path)}, "
+                        f"no longer matches: {printable(wiring.why)})")
+        head += [f"name = {json.dumps(name)}", "wires = []"]  # a JSON string: a TOML string
+    else:
+        head += [f"# {given_back(wiring.rig)} from the rig flashed on {wiring_date(wiring)}: "
+                 f"{printable(wiring.path)}", f"name = {json.dumps(name)}",
+                 *_wiring_lines(wiring.rig)]
     for m in members:
         model = json.dumps(m.model) if m.model else '"?"  # VE named no model mercmac knows'
         head += ["", f"[controllers.{m.name}]", f"address = {m.address}", f"model = {model}",
                  f"program = {json.dumps(m.name + '.mcm')}"]
     return "\n".join(head) + "\n"
+
+
+def wiring_date(wiring: Wiring) -> str:
+    """When the recorded rig was last flashed to the chain: '2026-11-22 10:41'."""
+    return wiring.record.when.strftime("%Y-%m-%d %H:%M")
+
+
+def given_back(rig: "Rig") -> str:
+    """'wires, box and joystick': what a pulled rig file takes from the rig flashed, as far
+    as that rig has them."""
+    parts = [part for part, has in (("wires", rig.wires), ("box", rig.box),
+                                    ("joystick", rig.joystick)) if has]
+    if not parts:
+        return "no wires"
+    return parts[0] if len(parts) == 1 else f"{', '.join(parts[:-1])} and {parts[-1]}"
+
+
+def _wiring_lines(rig: "Rig") -> list[str]:
+    """The box, the wires and the [joystick] table of `rig` as its file states them."""
+    import json
+
+    lines = []
+    if rig.box is not None:
+        lines += [f"box = {json.dumps(rig.box)}",
+                  f"box_buttons = [{', '.join(map(str, rig.box_buttons))}]"]
+    wires = [f"  {json.dumps(str(w))}," for w in rig.wires]
+    lines += ["wires = [", *wires, "]"] if wires else ["wires = []"]
+    if rig.joystick:
+        lines += ["", "[joystick]"] + [f"{branch} = {json.dumps(controller)}"
+                                       for branch, controller in rig.joystick.items()]
+    return lines

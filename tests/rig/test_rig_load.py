@@ -23,7 +23,8 @@ def test_the_raster_rig_reads_whole():
     assert [str(w) for w in rig.wires] == ["x.out1 -> y.in1", "y.out2 -> x.in2"]
     assert rig.drivers("y", 1)[0].source.kind is LineKind.OUT
     assert rig.by_address(1).name == "y" and rig.by_address(7) is None
-    assert rig.controller("x").span.line == 23  # its [controllers.x] header
+    assert rig.controller("x").span.line == 30  # its [controllers.x] header
+    assert rig.joystick == {"X": "x", "Y": "y"}  # as the README shows it
 
 
 def test_rig_paths_are_named_so_in_any_case():
@@ -107,6 +108,21 @@ def test_the_readme_documents_the_keys_of_a_rig_file():
     toml = section.split("```toml\n", 1)[1].split("```", 1)[0]
     rig_file = parse_rig(Source(str(RASTER.parent / "readme.rig.toml"), toml))
     assert rig_file.report.items == [] and rig_file.rig.joystick == {"X": "x", "Y": "y"}
+
+
+def test_the_readme_shows_the_bundled_raster_rig_as_it_is():
+    """The README showed the raster "with the [joystick] table added", which the bundled
+    file had not: the joystick example of docs/rigs.md was refused on it."""
+    from dataclasses import replace
+
+    from helpers.readme import README
+    from mercmac.rig.load import parse_rig
+    from mercmac.source import Source
+
+    toml = README.split("### Rigs", 1)[1].split("```toml\n", 1)[1].split("```", 1)[0]
+    shown = parse_rig(Source(str(RASTER), toml)).rig
+    bundled = read_rig(str(RASTER)).rig
+    assert replace(shown, path="") == replace(bundled, path="")
 
 
 @pytest.mark.parametrize("name", ["../../x", "/abs/x", "a/b", "..", "", "a b", "x\\y", "2x"])

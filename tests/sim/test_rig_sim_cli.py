@@ -9,6 +9,7 @@ import re
 import pytest
 
 from helpers.cli import cli, mercmac_process, sim
+from helpers.paths import ROOT
 from helpers.rigs import RASTER, rig_of
 
 SPEC_KEYS = {"until_ms", "halted", "final", "reports", "outputs", "hazards", "events"}
@@ -87,6 +88,63 @@ def test_the_joystick_moves_the_controller_of_its_branch(tmp_path):
     assert out["x"]["final"]["position"] > 7000 and out["y"]["final"]["position"] < -7000
     bad = sim(path, "--joystick", "x=2@1s")
     assert bad.exit_code == 2 and "from -1 to 1" in bad.output
+
+
+def _docs_joystick_examples() -> set[tuple[str, str]]:
+    """(rig file, `--joystick` spec) of the examples in the README and docs/rigs.md."""
+    found = set()
+    for page in (ROOT / "README.md", ROOT / "docs" / "rigs.md"):
+        text = page.read_text(encoding="utf-8")
+        found |= set(re.findall(r'mercmac sim (\S+) --joystick "([^"]+)"', text))
+    return found
+
+
+def test_the_docs_joystick_example_runs_on_the_bundled_raster():
+    """It was refused (the raster had no [joystick] table); with one, +0.5 on x read as
+    "joystick pressed" and -1 on branch Y showed nothing at all."""
+    ((path, spec),) = _docs_joystick_examples()
+    assert (ROOT / path) == RASTER and spec == "x=+0.5@1s-3s,Y=-1@4s"  # a controller, a branch
+    result = sim(RASTER, "--joystick", spec)
+    assert result.exit_code == 0, result.output
+    lines = result.stdout.splitlines()
+    off = "commands nothing, joystick control is off (no JN)"  # the raster never sends JN
+    assert f"1.000 s  x  joystick at +0.50 (input 5 ON): {off}" in result.stdout
+    assert f"3.000 s  x  joystick back in the middle (input 5 OFF): {off}" in result.stdout
+    assert f"4.000 s  y  joystick at -1.00 (input 5 OFF): {off}" in result.stdout
+    assert not any("joystick pressed" in line or "joystick released" in line for line in lines)
+    shown = (ROOT / "docs" / "rigs.md").read_text(encoding="utf-8").split("```text\n", 1)[1]
+    assert shown.split("```", 1)[0].splitlines() == [line for line in lines if "joystick" in line]
+    out = json.loads(sim(RASTER, "--joystick", spec, "--format", "json").stdout)
+    (moved,) = [e for e in out["controllers"]["y"]["events"] if e["kind"] == "joystick"]
+    assert moved == {"t_ms": 4000, "kind": "joystick", "deflection": -1.0, "velocity": 0.0,
+                     "jn": 0, "table": 1}
+
+
+def test_the_timeline_says_the_velocity_a_deflection_commands(tmp_path):
+    # JN 8000 through the cubic table (MS176E §6.4 JT, the factory default): half a
+    # deflection is 8000 * 0.5**3 = 1000 steps/s (C-663s); full the other way, -8000
+    path = rig_of(tmp_path, "autostart { JN 8000 }\n", "autostart { JN 8000 }\n", "",
+                  '[joystick]\nX = "x"\nY = "y"\n')
+    result = sim(path, "--joystick", "x=+0.5@1s-2s,Y=-1@1s-2s", "--until", "3s")
+    assert result.exit_code == 0, result.output
+    said = result.stdout
+    assert "x  joystick at +0.50 (input 5 ON): commands +1,000 steps/s (JN 8000, cubic table)" \
+        in said
+    assert "y  joystick at -1.00 (input 5 OFF): commands -8,000 steps/s (JN 8000, cubic table)" \
+        in said
+    assert "x  joystick back in the middle (input 5 OFF): commands 0 steps/s" in said
+
+
+@pytest.mark.parametrize("toml, words", [
+    ("", "Y is a joystick branch, and the rig has no [joystick] table"),
+    ('[joystick]\nX = "x"\n', 'the rig\'s [joystick] table has no branch Y (only X = "x")'),
+])
+def test_a_branch_the_rig_does_not_connect_is_said_to_be_a_branch(tmp_path, toml, words):
+    """It said "the rig has no controller 'Y' (x, y)", as if Y were no spelling at all."""
+    path = rig_of(tmp_path, "autostart { WA 1 }\n", "autostart { WA 1 }\n", "", toml)
+    result = sim(path, "--joystick", "Y=-1@4s")
+    assert result.exit_code == 2, result.output
+    assert words in result.stderr and "Traceback" not in result.output
 
 
 def test_the_joystick_is_for_rigs(tmp_path):
@@ -206,13 +264,19 @@ def test_a_program_with_errors_is_not_simulated(tmp_path):
     ("y:1@0-100ms", "the box is plugged into x"),  # the box is not on y
     ("x:2@1s", "driven by the wire y.out2 -> x.in2"),  # the run mixed both on one line
     ("x:4@1s", "button 4 of the box is not connected to x (box_buttons = [1, 3])"),
-    ("x:5@1s", "no joystick branch goes to x"),  # the raster has no joystick
     ("x:1@0-100ms,x:1+2@2s", "driven by the wire y.out2 -> x.in2"),
 ])
 def test_buttons_press_only_what_the_rig_lets_a_person_press(press, words):
     result = sim(RASTER, "--buttons", press, "--until", "3s")
     assert result.exit_code == 2, result.output
     assert words in result.stderr and result.stdout == "" and "Traceback" not in result.output
+
+
+def test_the_joystick_inputs_are_pressed_only_where_a_branch_goes(tmp_path):
+    path = rig_of(tmp_path, "autostart { WN 5, CN 1 }\n", "autostart { CN 1 }\n", "")
+    result = sim(path, "--buttons", "x:5@1s", "--until", "3s")
+    assert result.exit_code == 2, result.output
+    assert "no joystick branch goes to x" in result.stderr and "Traceback" not in result.output
 
 
 def test_the_joystick_inputs_are_pressed_where_a_branch_goes(tmp_path):

@@ -53,12 +53,78 @@ def test_pull_rig_gives_back_the_flashed_rig_and_it_round_trips(rig, tmp_path, d
     assert again.changes_nothing
     assert sorted(p.name for p in out.iterdir()) == ["raster.rig.toml", "x.mcm", "y.mcm"]
     assert (out / "x.mcm").read_text() == (rig.parent / "x.mcm").read_text()  # names, comments
-    text = (out / "raster.rig.toml").read_text()
-    assert "Wires cannot be read from controllers" in text
     pulled = read_rig(str(out / "raster.rig.toml")).rig
     assert [(c.name, c.address, c.model) for c in pulled.controllers] == [("x", 0, "C-663"),
                                                                           ("y", 1, "C-663")]
     assert cli("check", out / "raster.rig.toml").exit_code == 0
+
+
+def _wiring(rig_file: Path) -> tuple:
+    """What a rig file says of the wiring: box, buttons, wires, joystick."""
+    found = read_rig(str(rig_file)).rig
+    return found.box, found.box_buttons, [str(w) for w in found.wires], dict(found.joystick)
+
+
+def _flashed_then_pulled(rig_file: Path, out: Path):
+    """`pull --rig OUT` of a chain that `rig_file` was flashed to (the history records it)."""
+    with chain() as (server, vcs):
+        flash_chain(server.path, str(rig_file), timing=FAST_TIMING)
+        result = cli("pull", server.path, "--rig", out, *FAST)
+    assert result.exit_code == 0, result.output
+    return result
+
+
+def test_pull_rig_gives_back_the_wiring_of_the_rig_flashed_to_the_chain(rig, tmp_path,
+                                                                       data_dir):
+    """It wrote `wires = []` (and no box, no joystick) although the history records the rig
+    file each controller was flashed from, and that file still matched the chain."""
+    out = tmp_path / "pulled"
+    result = _flashed_then_pulled(rig, out)
+    assert _wiring(out / "raster.rig.toml") == _wiring(rig)
+    assert _wiring(rig)[2] and _wiring(rig)[3]  # the raster has wires and a joystick
+    text = (out / "raster.rig.toml").read_text()
+    said = "wires, box and joystick from the rig flashed on "
+    assert said in text and str(rig) in text and "Wires cannot be read" not in text
+    (line,) = [line for line in result.output.splitlines() if line.startswith("rig: ")]
+    assert said in line and line.endswith(f": {rig})")
+    assert "check: clean" in result.output
+
+
+def test_a_rig_of_wires_alone_gives_back_its_wires_and_says_just_that(tmp_path, data_dir):
+    from helpers.rigs import write_rig
+
+    flashed = write_rig(tmp_path)  # two wired controllers, no box, no joystick
+    out = tmp_path / "pulled"
+    result = _flashed_then_pulled(flashed, out)
+    assert _wiring(out / "r.rig.toml") == _wiring(flashed)
+    text = (out / "r.rig.toml").read_text()
+    assert "# wires from the rig flashed on " in text and "box" not in text
+    assert "; wires from the rig flashed on " in result.output
+
+
+def _edited(rig: Path) -> None:
+    x = rig.parent / "x.mcm"
+    x.write_text(x.read_text().replace("const LINE = 20000", "const LINE = 30000"))
+
+
+@pytest.mark.parametrize("change, why", [
+    (_edited, "x.mcm no longer builds to what x holds"),
+    (lambda rig: rig.unlink(), "it cannot be read"),
+    (lambda rig: rig.write_text(rig.read_text().replace("address = 1", "address = 2")),
+     "its y at address 2 did not answer"),
+])
+def test_a_recorded_rig_that_no_longer_matches_gives_no_wires_and_says_why(
+        rig, tmp_path, data_dir, change, why):
+    out = tmp_path / "pulled"
+    with chain() as (server, vcs):
+        flash_chain(server.path, str(rig), timing=FAST_TIMING)
+        change(rig)
+        result = cli("pull", server.path, "--rig", out, *FAST)
+    assert result.exit_code == 0, result.output
+    text = (out / "raster.rig.toml").read_text()
+    assert "wires = []" in text and "Wires cannot be read from controllers" in text
+    assert _wiring(out / "raster.rig.toml") == (None, (1, 2, 3, 4), [], {})
+    assert f"no longer matches: {why}" in text and f"no longer matches: {why}" in result.output
 
 
 def test_a_chain_mercmac_never_flashed_is_named_by_address(tmp_path, data_dir):
@@ -67,6 +133,9 @@ def test_a_chain_mercmac_never_flashed_is_named_by_address(tmp_path, data_dir):
         result = cli("pull", server.path, "--rig", out, *FAST)
     assert result.exit_code == 0, result.output
     assert sorted(p.name for p in out.iterdir()) == ["a0.mcm", "a1.mcm", "bench.rig.toml"]
+    text = (out / "bench.rig.toml").read_text()
+    assert "wires = []" in text and "Wires cannot be read from controllers" in text
+    assert "no longer matches" not in text  # no rig was ever flashed there
     for address, macros in enumerate(RAW):
         program = compile_file(str(out / f"a{address}.mcm")).program
         assert {s: m.line for s, m in program.macros.items()} == macros
@@ -83,6 +152,25 @@ def test_decompile_rig_writes_sources_that_build_to_what_each_holds(tmp_path, da
         assert "[MC" not in text  # decompiled, not the raw blocks
         program = compile_file(c.program, c.model).program
         assert {s: m.line for s, m in program.macros.items()} == macros
+
+
+def test_decompile_rig_says_which_controllers_got_their_recorded_source_and_why(
+        rig, tmp_path, data_dir):
+    """It was documented to write decompiled sources, and wrote the recorded ones without a
+    word of why: x holds a build the history records, the other controller does not."""
+    out = tmp_path / "sources"
+    with chain(({}, RAW[1])) as (server, vcs):
+        flash_chain(server.path, str(rig), only=["x"], timing=FAST_TIMING)
+        result = cli("decompile", "--port", server.path, "--rig", out, *FAST)
+    assert result.exit_code == 0, result.output
+    assert (out / "x.mcm").read_text() == (rig.parent / "x.mcm").read_text()  # as flashed
+    assert "[MC" not in (out / "a1.mcm").read_text()  # decompiled
+    lines = result.output.splitlines()
+    assert "recorded source (x): each holds a build the flash history records" in result.output
+    assert any(line.startswith("decompiled (a1): no flash in the history left exactly what it "
+                               "holds: made from the stored macros") for line in lines)
+    # y of the rig answered with macros flashed from nowhere: the rig's wires are not given
+    assert "no longer matches: its y (address 1) holds no build flashed from it" in result.output
 
 
 def test_rig_with_options_that_do_not_go_with_it_is_refused(tmp_path):
@@ -127,6 +215,32 @@ def test_a_poisoned_history_never_leads_out_of_the_folder(rig, tmp_path, data_di
     assert cli("check", out / "pulled.rig.toml").exit_code == 0
 
 
+@pytest.mark.parametrize("where", ["fifo", "name\nwires = [\"x.out1 -> y.in2\"]\n"])
+def test_a_poisoned_rig_path_in_the_history_is_read_safely_and_said_escaped(rig, tmp_path,
+                                                                            data_dir, where):
+    """The recorded rig file is a FIFO (never opened to block the pull) or a name holding a
+    newline (which must not end the comment that quotes it and add a key)."""
+    import json
+    import os
+
+    target = tmp_path / where
+    if where == "fifo":
+        os.mkfifo(target)
+    out = tmp_path / "pulled"
+    with chain() as (server, vcs):
+        flash_chain(server.path, str(rig), timing=FAST_TIMING)
+        for path in (data_dir / "history").glob("*.json"):
+            record = json.loads(path.read_text())
+            record["rig"] = str(target)
+            path.write_text(json.dumps(record))
+        result = cli("pull", server.path, "--rig", out, *FAST)
+    assert result.exit_code == 0, result.output
+    text = (out / "raster.rig.toml").read_text()
+    assert "wires = []\n" in text and "no longer matches: it cannot be read" in text
+    assert _wiring(out / "raster.rig.toml")[2] == []
+    assert cli("check", out / "raster.rig.toml").exit_code == 0
+
+
 @pytest.mark.parametrize("folder,name", [("2026", "_2026"), ("my rig-1", "my_rig_1"),
                                          ("été", "t"), ("--", "rig")])
 def test_a_rig_named_after_its_folder_checks_clean(tmp_path, data_dir, folder, name):
@@ -162,7 +276,9 @@ def test_pulling_into_the_rigs_own_folder_needs_force(rig, data_dir, command):
     assert all(name in said for name in ("raster.rig.toml", "x.mcm", "y.mcm"))
     assert "--force" in said and "nothing was written" in said
     assert forced.exit_code == 0, forced.output
-    assert "wires = []" in (folder / "raster.rig.toml").read_text()
+    # the rig file replaced was the one flashed: its wiring was read before it was replaced
+    assert "read by mercmac" in (folder / "raster.rig.toml").read_text()
+    assert _wiring(folder / "raster.rig.toml")[2] == ["x.out1 -> y.in1", "y.out2 -> x.in2"]
 
 
 def test_every_target_is_checked_before_the_first_is_written(tmp_path, data_dir):
