@@ -16,6 +16,13 @@ from mercmac.suggest import candidates, distance
 C663 = "C-663"
 C863 = "C-863"
 MODELS = (C663, C863)
+
+
+def unit(model: str | None) -> str:
+    """What distances count in on `model` (MS176E §1.2, §3.4.2): the C-663 steps (microsteps,
+    1/16 of a full step), the C-863 encoder counts; counts when the model is unknown. Every
+    place that shows a distance says this one word: describe, the timeline, the plot."""
+    return "steps" if model == C663 else "counts"
 BOTH = frozenset(MODELS)
 ONLY_663 = frozenset({C663})
 ONLY_863 = frozenset({C863})
@@ -52,6 +59,14 @@ class Arg(str, Enum):
     OPTIONAL = "optional"
 
 
+class Reading(NamedTuple):
+    """Where the manual says two things of a command, or nothing, what mercmac takes:
+    `mercmac explain MNEMONIC` and the editor's hover show it beside the command."""
+
+    manual: str  # what the manual says, with its sections
+    mercmac: str  # the reading mercmac takes, where it acts on it, and why
+
+
 class Command(NamedTuple):
     """One native command as the manual defines it."""
 
@@ -71,6 +86,7 @@ class Command(NamedTuple):
     power_on: tuple[tuple[str, int], ...] = ()  # (model, value) after power-on or RT
     reads: str | None = None  # the setting a report command reports (§6.2)
     unsigned: bool = False  # the report shows its value without a sign (§6.4 examples)
+    readings: tuple[Reading, ...] = ()  # where mercmac chose between readings of the manual
 
     @property
     def section(self) -> str:
@@ -122,6 +138,15 @@ _O, _S, _T, _MM = Kind.OUTPUT, Kind.SETTING, Kind.REPORT, Kind.MACRO
 # FQ 0.8 as 80, WT 0, WW 5; §6.4 SM default 2000) and §3.4.2 (C-663: DC 200 mA, HC 100 mA,
 # HT 200 ms); the other settings start at 0.
 _GAIN = dict(arg=_OPT, arg_name="a gain", lo=0, hi=MAX_UINT16, default=0, note_default=True)
+_INPUT_5 = Reading(
+    '§6.4 XN names input 5 "Joystick input" and does not say when it counts as ON',
+    "the simulator takes it as ON while the joystick stands above mid-scale "
+    "(docs/simulator.md, \"Conditions\")")
+_SOFT_LIMITS = Reading(
+    "§3.4.1 gives the C-863 soft limits of +100,000,000 and -100,000,000 counts after "
+    "power-on; §3.4.2 gives the C-663 none",
+    "the simulator powers a C-663 on without soft limits (as after JC) and a C-863 with "
+    "+/-100,000,000 (docs/simulator.md, \"Motion\")")
 
 _TABLE = (
     # -- motion (§3.5, §4.3, §4.4, §6.4) --
@@ -142,11 +167,22 @@ _TABLE = (
     _c("JF", "Joystick and trackball off", _M, 65),
     _c("JA", "Trackball mode on, n counts per signal transition", _M, 62,
        arg=_REQ, arg_name="an increment", lo=0, **_on(c863=0, c663=0)),
-    _c("MN", "Motor (servo) on", _M, 69),
+    _c("MN", "Motor (servo) on", _M, 69, readings=(Reading(
+        "§3.5.1 sends MN before the first move, the stand-alone examples of §3.8.6 never "
+        "do; neither says whether the servo is on after power-on",
+        "the simulator starts with the servo on, so those examples move; `sim --servo-off` "
+        "gives the other answer, and a move with the servo off is the move-servo-off hazard "
+        "(docs/simulator.md, \"Motion\")"),)),
     _c("MF", "Motor (servo) off", _M, 69),
     # -- waits (§6.4) --
     _c("WA", "Wait n ms from the start of this command", _W, 84,
-       arg=_REQ, arg_name="a time in ms", lo=0, hi=MAX_UINT16),
+       arg=_REQ, arg_name="a time in ms", lo=0, hi=MAX_UINT16, readings=(Reading(
+           '§6.4 WA heads its range "0 < n < 65,535", which leaves out 0 and 65,535; the '
+           'headings of §6.4 are loose (DD: "0 < n < 32,767" above "Range: 0 to 65,535", '
+           'SM: "0 < n < 32,767" above "0 to 2^32")',
+           "0-65,535 is accepted, the whole range of a 16-bit count: argument-range "
+           "fires only outside it, and the simulator lets WA0 take its one cycle. A line "
+           "meant for every firmware keeps to 1-65,534"),)),
     _c("WS", "Wait until the motor is on target, then n ms (default 1000)", _W, 85,
        arg=_OPT, arg_name="a time in ms", lo=0, hi=MAX_UINT16, default=1000, note_default=True),
     _c("WN", "Wait until input n is ON (button n of the C-170.PB box pressed)", _W, 85,
@@ -156,14 +192,28 @@ _TABLE = (
     # -- conditions (§5.5, §6.4 XN/XF): inputs 1-4, 5 joystick, 6 joystick button --
     _c("XN", "Execute the rest of the line only if input n is ON (1-4 the box's buttons, "
        "5 joystick, 6 joystick button)", _X, 87,
-       arg=_REQ, arg_name="an input", lo=1, hi=6),
+       arg=_REQ, arg_name="an input", lo=1, hi=6, readings=(_INPUT_5,)),
     _c("XF", "Execute the rest of the line only if input n is OFF (1-4 the box's buttons, "
        "5 joystick, 6 joystick button)", _X, 87,
-       arg=_REQ, arg_name="an input", lo=1, hi=6),
+       arg=_REQ, arg_name="an input", lo=1, hi=6, readings=(_INPUT_5,)),
     # -- macro calls and repeats (§3.8, §6.4 EM/RP) --
     _c("EM", "Execute macro n", _E, 52, arg=_REQ, arg_name="a macro number", lo=1, hi=31),
     _c("RP", "Repeat the line from its beginning n more times (default 65535)", _R, 70,
-       arg=_OPT, arg_name="a repeat count", lo=0, hi=32_568, default=65_535, note_default=True),
+       arg=_OPT, arg_name="a repeat count", lo=0, hi=32_568, default=65_535, note_default=True,
+       readings=(Reading(
+           '§6.4 RP: without n the line "repeats indefinitely"; but §3.8.6 (Examples 1 '
+           'and 4) says `RP,RP` makes a line "repeat more than 4 billion times (in our '
+           'scale, forever)", which only a bare RP that ends can do',
+           "a bare RP is read as RP65535: the line runs 65,536 times, and `RP,RP` "
+           "2^32 = 4,294,967,296 times, the \"more than 4 billion\". check (the "
+           "default-argument info), the simulator and the emulator all count so, while "
+           "RP n itself keeps to §6.4's \"n <= 32568\". On a firmware that repeats for "
+           "ever, only the end of a run of hours differs"), Reading(
+           "§6.4 RP says nothing of two RPs in one line; §3.8.6 only counts `RP,RP` as "
+           "\"more than 4 billion\" passes",
+           "each RP has its own counter: set to n on its first arrival, counted down on "
+           "the later ones, forgotten when it runs out, and reset when the macro is entered "
+           "(docs/simulator.md, \"Repeat counters\")"))),
     # -- outputs (§4.5) --
     # The C-170.PB box shows the outputs on its LEDs (§3.8.6).
     _c("CN", "Output n ON (lights LED n of the C-170.PB pushbutton box)", _O, 48,
@@ -173,7 +223,10 @@ _TABLE = (
     _c("CP", "Set outputs 1-4 (the box's LEDs) to the bit pattern n (bit 0 = output 1)", _O, 49,
        arg=_REQ, arg_name="an output pattern", lo=0, hi=15),
     _c("ZM", "Trigger mode on output 4 (0 off, 1 single, 2 multiple, 3 grid)", _O, 89,
-       arg=_REQ, arg_name="a trigger mode", lo=0, hi=3),
+       arg=_REQ, arg_name="a trigger mode", lo=0, hi=3, readings=(Reading(
+           "§4.5.2 and §6.4 ZM give no width for a trigger pulse",
+           "the simulator makes each pulse 100 us long, which keeps pulses apart up to "
+           "10,000 a second"),)),
     _c("ZP", "Trigger position", _O, 89, arg=_REQ, arg_name="a position",
        lo=-MAX_INT32, hi=MAX_INT32),
     _c("ZI", "Trigger increment", _O, 88, arg=_REQ, arg_name="an increment",
@@ -191,30 +244,40 @@ _TABLE = (
     _c("LL", "Limit switches active low", _S, 67),
     _c("JC", "Clear soft limits", _S, 63),
     _c("JH", "Upper soft limit", _S, 64, arg=_REQ, arg_name="a position",
-       lo=-MAX_INT32, hi=MAX_INT32),
+       lo=-MAX_INT32, hi=MAX_INT32, readings=(_SOFT_LIMITS,)),
     _c("JL", "Lower soft limit", _S, 64, arg=_REQ, arg_name="a position",
-       lo=-MAX_INT32, hi=MAX_INT32),
+       lo=-MAX_INT32, hi=MAX_INT32, readings=(_SOFT_LIMITS,)),
     _c("JB", "Joystick bias added to the joystick reading", _S, 63,
        arg=_REQ, arg_name="a bias", lo=-255, hi=255, **_on(c863=0, c663=0)),
     _c("JT", "Load a predefined joystick table (0-3)", _S, 66,
        arg=_REQ, arg_name="a table number", lo=0, hi=3),
     _c("SI", "Joystick table index", _S, 73, arg=_REQ, arg_name="a table index", lo=0, hi=255,
        **_on(c863=0, c663=0)),
-    # §6.4 SJ says -1024..1024, §3.6.2 says 0..1024: accept the wider range.
     _c("SJ", "Joystick table value at the current index", _S, 73,
-       arg=_REQ, arg_name="a table value", lo=-1024, hi=1024, **_on(c863=0, c663=0)),
+       arg=_REQ, arg_name="a table value", lo=-1024, hi=1024, **_on(c863=0, c663=0),
+       readings=(Reading(
+           '§6.4 SJ: "Table values range from -1024 to 1024"; §3.6.2: "Range of n: 0 to '
+           '1024"',
+           "-1024 to 1024 is accepted, the wider range, since §6.4's own example "
+           "writes SJ-1024"),)),
     _c("SC", "Select this controller (autostart macro only)", _S, 72,
        arg=_REQ, arg_name="an address", lo=0, hi=15),
-    # §6.4 DD says 0 < n < 32,767 in its heading and 0..65,535 in its text.
-    _c("DD", "Derivative gain, position control", _S, 50, models=ONLY_863, **_GAIN, **_on(c863=0)),
+    _c("DD", "Derivative gain, position control", _S, 50, models=ONLY_863, **_GAIN, **_on(c863=0),
+       readings=(Reading(
+           '§6.4 DD heads its range "0 < n < 32,767" and says "Range: 0 to 65,535" below',
+           "0-65,535 is accepted, the text's range and that of the other gains (DI, DL, "
+           "DP, FD, FI, FL, FP)"),)),
     _c("DI", "Integral gain, position control", _S, 50, models=ONLY_863, **_GAIN, **_on(c863=0)),
     _c("DL", "Integral limit, position control", _S, 51, models=ONLY_863, **_GAIN,
        **_on(c863=2000)),
     _c("DP", "Proportional gain, position control", _S, 51, models=ONLY_863, **_GAIN,
        **_on(c863=35)),
-    # §6.4 FA says 0..1024, §4.1.5 says -1000 < n < 1000: accept both.
     _c("FA", "Force control target", _S, 52, models=ONLY_863,
-       arg=_REQ, arg_name="a force target", lo=-1000, hi=1024, **_on(c863=0)),
+       arg=_REQ, arg_name="a force target", lo=-1000, hi=1024, **_on(c863=0),
+       readings=(Reading(
+           '§6.4 FA: "Range: 0 to 1024"; §4.1.5: "-1000 < n < +1000"',
+           "-1000 to 1024 is accepted, what either section allows, so that no value "
+           "the manual gives is refused; 0-999 satisfies both"),)),
     _c("FD", "Derivative gain, force control", _S, 53, models=ONLY_863, **_GAIN, **_on(c863=0)),
     _c("FI", "Integral gain, force control", _S, 54, models=ONLY_863, **_GAIN, **_on(c863=0)),
     _c("FL", "Integral limit, force control", _S, 55, models=ONLY_863, **_GAIN, **_on(c863=2000)),
@@ -235,9 +298,11 @@ _TABLE = (
        arg=_REQ, arg_name="a filter count", lo=0, hi=MAX_UINT16, **_on(c863=0)),
     _c("SF", "Encoder input filter", _S, 73, models=ONLY_863,
        arg=_REQ, arg_name="a filter count", lo=0, hi=255, **_on(c863=0)),
-    # §6.4 SM: heading 0 < n < 32,767, text 0 to 2^32.
     _c("SM", "Maximum following error", _S, 74, models=ONLY_863,
-       arg=_REQ, arg_name="a following error", lo=0, hi=2**32, **_on(c863=2000)),
+       arg=_REQ, arg_name="a following error", lo=0, hi=2**32, **_on(c863=2000),
+       readings=(Reading(
+           '§6.4 SM heads its range "0 < n < 32,767" and says "Range of n: 0 to 2^32" below',
+           "0 to 2^32 is accepted, the text's range"),)),
     _c("WT", "Settle time in ms for on-target detection", _S, 86, models=ONLY_863,
        arg=_REQ, arg_name="a time in ms", lo=0, hi=MAX_UINT16, **_on(c863=0)),
     _c("WW", "Settle window in counts", _S, 86, models=ONLY_863,
@@ -265,17 +330,30 @@ _TABLE = (
     _c("TE", "Report position error", _T, 77, models=ONLY_863, report="E:"),
     _c("TF", "Report following error", _T, 77, models=ONLY_863, report="F:"),
     _c("TI", "Report the current repeat counter", _T, 78, report="X:"),
-    # §6.2 lists "T:" for TL; the examples in §6.1.3 and §6.4 report "L:".
-    _c("TL", "Report programmed acceleration", _T, 78, report="L:"),
+    _c("TL", "Report programmed acceleration", _T, 78, report="L:", readings=(Reading(
+        '§6.2 lists "T:" as the report identifier of TL; the examples of §6.1.3 and §6.4 TL '
+        'report "L:+0000170000"',
+        'the simulator and the emulator report "L:", as the examples do ("T:" is TT\'s)'),)),
     _c("TP", "Report position", _T, 79, report="P:"),
     _c("TR", "Report the additional (force) sensor", _T, 79, models=ONLY_863, report="R:"),
-    _c("TS", "Report status", _T, 80, report="S:"),
+    _c("TS", "Report status", _T, 80, report="S:", readings=(Reading(
+        "§6.4 TS does not say when its error code clears, and no command clears it",
+        "reading it (TS or %) clears it to 00 in the simulator and the emulator, as ERR? "
+        "does in PI's GCS commands (manual MS163E), which these controllers also take "
+        "(§1.1); a code that never cleared would make every later TS report an old mistake"),)),
     _c("TT", "Report target position", _T, 83, report="T:"),
     _c("TV", "Report current profile velocity", _T, 83, report="V:"),
     _c("TY", "Report programmed velocity", _T, 83, report="Y:"),
     _c("VE", "Report firmware version", _T, 84),
     _c("TM", "Report macro n, or all but macro 0", _T, 78,
-       arg=_OPT, arg_name="a macro number", lo=0, hi=31, default=0, report="MC"),
+       arg=_OPT, arg_name="a macro number", lo=0, hi=31, default=0, report="MC",
+       readings=(Reading(
+           "§6.4 TM does not say how a listing of several macros is framed, nor what TMn "
+           "answers for an empty slot",
+           "the uploader takes CR LF after each line with one ETX at the end, or an ETX "
+           "after every line, and an empty report or a bare MCnnn as an empty slot; "
+           "`emulate --tm-framing` and `--empty-slot` serve each (docs/uploader.md, "
+           "\"Reading macros back\")"),)),
     _c("TZ", "Report macro 0", _T, 84, report="MC"),
     _c("FA?", "Report force control target", _T, 52, models=ONLY_863, report="FA:"),
     _c("FD?", "Report force D-term", _T, 53, models=ONLY_863, report="FD:"),
@@ -366,10 +444,13 @@ def lookup(mnemonic: str) -> Command | None:
 def search(words: Iterable[str], model: str | None = None,
            guessed: Mapping[str, Iterable[str]] | None = None) -> list[Command]:
     """The commands (of `model`) that every word describes, best first: its mnemonic, then
-    a word of its summary, argument or kind (`led`, `wait`, `velocity`), then a natural
-    guess for it (`guessed`: word -> mnemonics; `sleep` -> WA), then the start of such a
-    word (`veloc`); among equals, the one that says the words earliest ("Set velocity"
-    before "Report programmed velocity"), then the table's order (the manual's kinds)."""
+    a natural guess for it (`guessed`: word -> mnemonics in the order meant; `sleep` -> WA,
+    `position` -> MA, TP, DH), then a word of its summary before any ',', ':' or '('
+    ("Move absolute to position n"), then elsewhere in its summary, argument or kind
+    ("Derivative gain, position control"), then a word the manual has for it (SYNONYMS:
+    `jog` is "joystick"), then the start of such a word (`veloc`); among equals, the one
+    that says the words earliest ("Set velocity" before "Report programmed velocity"),
+    then the table's order (the manual's kinds)."""
     words = [w.lower() for text in words for w in text.split()]
     found = []
     for index, c in enumerate(_TABLE):
@@ -379,19 +460,49 @@ def search(words: Iterable[str], model: str | None = None,
     return [_TABLE[index] for *_, index in sorted(found)]
 
 
+# Words users come with for what the manual calls otherwise, as words of the summaries:
+# a search for one finds every command described so. Words only, no mnemonics; the words
+# people write in a macro, with what to write instead, are compiler/guesses.py's.
+SYNONYMS: dict[str, tuple[str, ...]] = {
+    "jog": ("joystick",), "accelerate": ("acceleration",), "decelerate": ("deceleration",),
+    "ramp": ("acceleration",), "speed": ("velocity",), "fast": ("velocity",),
+    "slow": ("velocity",), "pushbutton": ("button",), "key": ("button",),
+    "homing": ("home", "reference"), "zero": ("home",), "origin": ("home",),
+    "pid": ("gain",), "tune": ("gain",), "get": ("report",), "query": ("report",),
+    "read": ("report",), "delete": ("remove",), "erase": ("remove",), "run": ("execute",),
+    "program": ("macro",), "pulse": ("trigger",),  # MS176E §4.5.2: trigger pulses
+}
+
+
 def _score(c: Command, word: str, guessed: Mapping[str, Iterable[str]]) -> tuple[int, int] | None:
     """How well `word` names `c`, and where its description says it (lower is better);
     None when it does not."""
     if word == c.mnemonic.lower():
         return 0, 0
+    pointed = tuple(guessed.get(word, ()))
+    if c.mnemonic in pointed:
+        return 1, pointed.index(c.mnemonic)
     described = _described(c)
-    at = _first(described, lambda w: w in (word, word + "s"))  # `led` finds "LEDs" too
+    at = _said(described, word)
     if at is not None:
-        return 1, at
-    if c.mnemonic in guessed.get(word, ()):
-        return 2, 0
+        return (2 if at < _head(c) else 3), at
+    said = [at for other in SYNONYMS.get(word, ()) if (at := _said(described, other)) is not None]
+    if said:
+        return 4, min(said)
     at = _first(described, lambda w: w.startswith(word)) if len(word) >= 3 else None
-    return None if at is None else (3, at)
+    return None if at is None else (5, at)
+
+
+def _said(described: tuple[str, ...], word: str) -> int | None:
+    """Where a description says `word` (`led` finds "LEDs" too)."""
+    return _first(described, lambda w: w in (word, word + "s"))
+
+
+@functools.cache
+def _head(c: Command) -> int:
+    """How many words of the description name what the command does: its summary up to a
+    ',', ':' or '(' ("Derivative gain" of "Derivative gain, position control")."""
+    return len(re.findall(r"[a-z0-9]+", re.split(r"[,:(]", c.summary.lower(), maxsplit=1)[0]))
 
 
 def _first(words: tuple[str, ...], test) -> int | None:

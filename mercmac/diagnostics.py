@@ -53,6 +53,8 @@ _TOO_MANY = "{macro} holds {count} commands; a macro holds at most {max} (MS176E
 _NESTED = ("{caller} calls {callee} and continues ({rest}), but {callee} calls {inner}: the "
            "controller keeps one return point (MS176E §3.8.4), so the rest of {caller} never "
            "runs after that")
+_IN_LOOP = (". A when block in a loop is a macro the loop calls, so it may end in a goto but "
+            "not call on")
 
 RULES: tuple[Rule, ...] = (
     Rule("MM001", "syntax", _E, "the file cannot be parsed", """\
@@ -99,7 +101,7 @@ and §6.2 of the manual has the full list.""", {"": "unknown command '{word}'{hi
 Commands such as MA, MR, EM, CN, WA or XN need a number right after the
 mnemonic (MS176E §6.1.2: "MR alone would be useless"). Arguments are decimal
 integers, optionally signed; in high-level blocks a `const` name may stand for
-the number. Commands without an argument (TP, GH, ...) take none.""", {
+the number, signed too (`MR -FAR`). Commands without an argument (TP, GH, ...) take none.""", {
         "model": "unknown model '{model}': use C-663 or C-863",
         "unexpected": "{expects}",
         "raw-name": "{expects}, found '{name}' (a raw block takes numbers only)",
@@ -153,7 +155,7 @@ A raw block or a pin (`macro NAME @n`) outside 0-31 cannot be stored, and a
 program that needs more than 32 macros after hoisting and splitting does not
 fit the controller. Merge small macros or drop unused ones.""", {
         "": "macro number {slot} is outside 0-31",
-        "full": "no free slot for '{name}': the program needs {count} macros and the "
+        "full": "no free slot for {name}: the program needs {count} macros and the "
                 "controller holds 32",
         "nesting": "blocks nested more than {depth} deep cannot fit the controller (32 macros "
                    "of 16 commands): move inner blocks into macros of their own",
@@ -171,8 +173,8 @@ SC (select controller) "is only allowed in the Macro 0 (autostart macro)"
 SC into `autostart { ... }` / `[MC00]`, outside any `when` or `repeat` block
 (those are hoisted into macros of their own).""", {
         "": "SC is only allowed in macro 0, the autostart macro",
-        "moved": "SC is only allowed in macro 0, the autostart macro (this block was moved "
-                 "into {macro})",
+        "moved": "SC is only allowed in macro 0, the autostart macro, and this SC runs in "
+                 "{macro}, a macro of its own",
     }),
     Rule("MM009", "not-in-macro", _E, "a command that cannot be stored in a macro", """\
 MD, RT, RM, RMALL and RZ manage the macro store itself and are for direct
@@ -194,8 +196,12 @@ MC18 can no longer return to its own caller. On raw blocks this is a warning
 (it is the manual's way of switching modes, Example 4); on `call` it is an
 error, and so is a `call` of a macro that ends in (or may run) a `goto`: it
 never comes back. Use `goto` for a transfer that is not meant to return, make
-the callee call nothing, or restructure. mercmac does this for you where the
-meaning stays the same:
+the callee call nothing, or restructure. A `when` block in a loop is a macro
+the loop calls, so work that calls on (or holds a loop of its own) goes in a
+macro that the block ends with `goto work`, and that ends with `goto` back
+to the macro the loop starts: `every 20ms { when 1 { goto work } }` in
+`macro jog`, and `macro work { repeat 100 { MR 10, WS 10 }, goto jog }`.
+mercmac does this for you where the meaning stays the same:
   - a hoisted `when`/`repeat` block that calls, or is too long for one macro,
     ends in a tail EM to a macro holding the rest of its caller;
   - a loop that starts its macro stays in the line, so the macro stays a leaf
@@ -208,8 +214,22 @@ meaning stays the same:
                            "parts, and a called macro must fit in one: shorten it, or `goto` it",
         "call": _NESTED + ". Use `goto` if the caller need not continue, or make the called "
                           "macro call nothing (a split or hoisted block calls on too)",
-        "loop": _NESTED + ". Inside a repeat or every loop a when block may run commands or end "
-                          "in a goto, but not call macros; move those commands into the block",
+        # a when block in a loop: goto the work, and goto back to the loop (MS176E §3.8.4)
+        "loop": _NESTED + _IN_LOOP + ": end the block with `goto {target}` instead, and end "
+                          "{target} with `goto {loop}`, back to the start of the loop",
+        "loop-block": _NESTED + _IN_LOOP + ", and {inner} is a macro of its own: move it (and "
+                                "what follows it in the block) into a macro, end the block "
+                                "with a `goto` to that macro, and end that macro with "
+                                "`goto {loop}`, back to the start of the loop",
+        "loop-unnamed": _NESTED + _IN_LOOP + ": end the block with `goto {target}` instead, and "
+                                  "end {target} with a `goto` back to the start of the loop at "
+                                  "line {line}, which needs a macro of its own for that",
+        "loop-block-unnamed": _NESTED + _IN_LOOP + ", and {inner} is a macro of its own: move "
+                                        "it (and what follows it in the block) into a macro, "
+                                        "end the block with a `goto` to that macro, and end "
+                                        "that macro with a `goto` back to the start of the "
+                                        "loop at line {line}, which needs a macro of its own "
+                                        "for that",
         "goto": "{caller} calls {callee} and continues ({rest}), but {chain} transfers for "
                 "good: the call never comes back, so the rest of {caller} never runs after it. "
                 "Write `goto` if the caller need not continue, or make the called macro end "
@@ -230,9 +250,9 @@ numbers.""", {"": "{macro} tests input {input} with both {first} and {second}: t
               "rest can only run if the input changed in between"}),
     Rule("MM014", "default-argument", _I, "argument omitted where the controller substitutes a default", """\
 Some commands take a default when the argument is left out: WS waits 1000 ms
-after the stop (§6.4 WS), a bare RP repeats 65535 times (§6.4 RP), and a gain
-such as `DI,` is set to 0 (Example 1). Write the value to make the intent
-explicit.""", {"": "{mnemonic} without an argument: the controller uses {default}"}),
+after the stop (§6.4 WS), a bare RP repeats 65535 times (mercmac's reading of
+§6.4 RP and §3.8.6: `mercmac explain RP` says why), and a gain such as `DI,` is
+set to 0 (Example 1). Write the value to make the intent explicit.""", {"": "{mnemonic} without an argument: the controller uses {default}"}),
     Rule("MM015", "joystick-in-macro", _W, "JN in a macro", """\
 CAUTION (MS176E §3.6.1, §3.8.6): "Do not enable a joystick axis when no
 joystick is connected to the controller hardware. Otherwise the corresponding
@@ -290,8 +310,8 @@ has its own RP counters that reset when it is entered (MS176E §6.4 RP, TI).
 A TI in a `when` block inside a loop runs in the macro the block is
 hoisted into, so it reports that macro's counter (0) instead of the loop's:
 `repeat 3 { when 1 { TI } }` reports 0, 0, 0 where the loop means 0, 2, 1.
-Move the TI out of the when block, straight into the loop.""", {"": "this TI runs in '{owner}', a macro of its own, not in '{loop}' with the RP "
-              "of its loop: it reports the counter of '{owner}' (0), not the loop's remaining "
+Move the TI out of the when block, straight into the loop.""", {"": "this TI runs in {owner}, a macro of its own, not in {loop} with the RP "
+              "of its loop: it reports that macro's counter (0), not the loop's remaining "
               "count (each macro has its own RP counters)"}),
     Rule("MM032", "repeat-zero", _I, "repeat 0: the block never runs", """\
 `repeat 0 { ... }` runs its block no times, so mercmac leaves it out (RP
@@ -311,13 +331,46 @@ bracket is never closed, that names a rule mercmac does not have, or that names
 none, turns nothing off - rather than guess, which could hide an error - and
 `check` says so here, as ruff reports a `# noqa` with an unknown code (RUF102).
 Close the bracket, fix the spelling (`mercmac explain` lists the rules), or
-remove the comment. Only `check` reads these comments.""", {
+remove the comment. Only `check` reads these comments.
+`// mercmac: expect[soft-limit-clamp]` is their twin for the simulator's hazards
+(MH001-MH008): the line means to cause them, so `sim` shows them there as
+accepted and `--fail-on-hazard` does not count them. One that cannot be read, or
+names no hazard rule, accepts nothing and is reported here too.""", {
         "unclosed": "this `mercmac: ignore[` has no closing `]`, so it turns nothing off: "
                     "write `// mercmac: ignore[RULE, ...]`",
         "unknown": "no rule {key}: this comment does not turn it off (`mercmac explain` "
                    "lists the codes and names)",
+        "expect-form": "write `// mercmac: expect[RULE, ...]` with the hazard rules this line "
+                       "means to cause (soft-limit-clamp, MH003, ...): as written it accepts "
+                       "nothing",
+        "expect-unknown": "no hazard rule {key}: `expect[...]` names the simulator's hazards "
+                          "(MH001-MH008, `mercmac explain MH003`), so it accepts nothing",
         "empty": "`mercmac: ignore[]` names no rule, so it turns nothing off: name the rules, "
                  "or write `// mercmac: ignore` for every rule on the line",
+    }),
+    Rule("MM035", "slow-poll", _I, "a when in a loop whose pass takes over 250 ms: a short press is missed", """\
+A condition is read once, when its XN or XF runs (MS176E §5.5, §6.4 XN/XF).
+So a `when` inside an `every` or `repeat` loop reads its buttons once per pass
+of the loop, and a press that begins and ends between two reads is never seen:
+in `every 500ms { when 1 { CN 1 } }` a press must last 500 ms to be sure to be
+seen. The same holds for a raw line that loops with RP and calls macros that
+start with XN/XF, as the manual's Example 4 polls its buttons (§3.8.6), which
+it does every 20 to 100 ms.
+mercmac adds up what a pass waits with no button pressed: WA n (n ms), the
+period of an `every`, the passes of a `repeat` inside, what a `call` waits,
+and WS n - n ms after a move of unknown length, so the message then says "at
+least". A `when` block adds nothing: it runs only while its buttons are held.
+It says so above 250 ms, longer than a quick press. Shorten the pass: poll
+often (`every 20ms`) and move the long work into the `when` blocks, or into a
+macro that a `when` block ends with `goto`; or wait for the press with WN n
+where nothing else has to run meanwhile.""", {
+        "": "this when reads {inputs} once per pass of the `{kind}` at line {line}, and a "
+            "pass takes {took}, so a button must be held {took} to be sure to be seen: a "
+            "shorter press may fall between two reads. Poll more often (every 20ms) and put "
+            "the long work in the when block",
+        "raw": "{call} runs {callee}, whose {condition} reads input {input} once per pass of "
+               "the RP loop of {loop}, and a pass takes {took}, so a button must be held "
+               "{took} to be sure to be seen: a shorter press may fall between two reads",
     }),
     # -- rigs (docs/rigs.md): the rig file, checked by mercmac/rig/checks.py --
     Rule("MR001", "rig-file", _E, "the rig file cannot be read as a rig", """\
@@ -332,7 +385,7 @@ is refused too): any other path is refused without opening the file, so a rig
 from elsewhere cannot make `check` show another file's lines. Fix the text at
 the position given.""", {
         "toml": "{error}",
-        "unknown": "unknown key '{key}' {where}; the keys are {keys}",
+        "unknown": "unknown key '{key}' {where}: {hint}the keys are {keys}",
         "missing": "{where} needs '{key}'",
         "type": "'{key}' {where} must be {expects}",
         "empty": "the rig names no controller: add a [controllers.NAME] table per controller",

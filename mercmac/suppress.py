@@ -1,5 +1,7 @@
 """Which diagnostics a user has turned off: by rule (`--select`/`--ignore`, settings) or by
-a comment on the line (`// mercmac: ignore[nested-call]`).
+a comment on the line (`// mercmac: ignore[nested-call]`); and which hazards of the
+simulator a line's comment accepts (`// mercmac: expect[soft-limit-clamp]`, read here with
+the same rules and reported alike when it cannot be read; docs/simulator.md, "Hazards").
 
 Only `check` and the language server (mercmac.compiler.checking) read these: `build`, `sim`
 and `flash` still refuse a file with errors.
@@ -22,17 +24,20 @@ from mercmac.source import Source, Span, split_lines
 # the first `]` or the end of the line (group 2 empty: unclosed), so a line of repeated
 # `//` or `[` costs one pass (a lazy `//.*?` before it was quadratic).
 _DIRECTIVE = re.compile(r"\bmercmac:[ \t]*ignore\b(?:[ \t]*\[([^\]]*)(\]?))?", re.IGNORECASE)
+_EXPECT = re.compile(r"\bmercmac:[ \t]*expect\b(?:[ \t]*\[([^\]]*)(\]?))?", re.IGNORECASE)
 _MENTION = re.compile("mercmac", re.IGNORECASE)
 _KEPT = "syntax"
 
 
 class Silenced(NamedTuple):
     """What the comments of one line turn off, read once per line: every rule, or these
-    codes; and the diagnostics of the directives that could not be read."""
+    codes; the hazard rules it expects (names); and the diagnostics of the directives that
+    could not be read."""
 
     every: bool
     codes: frozenset[str]
     problems: tuple[Diagnostic, ...]
+    expects: frozenset[str] = frozenset()
 
 
 def rule_set(keys: Iterable[str], option: str) -> frozenset[str]:
@@ -102,7 +107,37 @@ def _read(file: str, number: int, text: str, start: int) -> Silenced | None:
             report.add("invalid-suppression", where, "unclosed")
         else:
             codes |= _codes(m.group(1), where, report)
-    return Silenced(every, frozenset(codes), tuple(report.items)) if matches else None
+    expects = set()
+    for m in _EXPECT.finditer(text, start):
+        where = Span(number, m.start() + 1, number, m.end() + 1)
+        if m.group(1) is None or not m.group(2) or not m.group(1).strip(", \t"):
+            report.add("invalid-suppression", where, "expect-form")
+        else:
+            expects |= _hazards(m.group(1), where, report)
+        matches.append(m)
+    return Silenced(every, frozenset(codes), tuple(report.items),
+                    frozenset(expects)) if matches else None
+
+
+def expected_hazards(source: Source) -> dict[int, frozenset[str]]:
+    """Line number -> the hazard rules (names) its comment expects: the simulator shows
+    them there as accepted, and counts them not (Program.expected)."""
+    return {n: line.expects for n, line in silenced_lines(source).items() if line.expects}
+
+
+def _hazards(keys: str, where: Span, report: Report) -> set[str]:
+    """The hazard rules named in an `expect[...]` (codes or names, any case); each name
+    that is no hazard rule is reported and accepts nothing."""
+    from mercmac.hazards import named
+
+    found = set()
+    for key in filter(None, (k.strip() for k in keys.split(","))):
+        name = named(key)
+        if name is None:
+            report.add("invalid-suppression", where, "expect-unknown", key=reprlib.repr(key))
+        else:
+            found.add(name)
+    return found
 
 
 def _codes(keys: str, where: Span, report: Report) -> set[str]:

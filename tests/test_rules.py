@@ -13,7 +13,7 @@ from helpers.compiling import program_of
 from helpers.paths import PACKAGE, ROOT
 from mercmac import diagnostics
 from mercmac.sim.simulate import simulate_program
-from mercmac.vm import hazards
+from mercmac import hazards
 from mercmac.vm.models import Options
 
 ALL = diagnostics.RULES + hazards.RULES

@@ -54,12 +54,12 @@ class _Commands(click.Group):
 
     def _meant(self, ctx: click.Context, name: str) -> str:
         """' Did you mean 'sim'?' for a synonym or a misspelling of a command; else ''."""
-        from mercmac.suggest import suggest
+        from mercmac.suggest import did_you_mean, question
 
-        names = self.list_commands(ctx)
-        meant = self.SYNONYMS.get(name.lower()) or (
-            suggest(name, names, max(1, len(name) // 3)) if len(name) <= 40 else None)
-        return f" Did you mean {meant!r}?" if meant else ""
+        synonym = self.SYNONYMS.get(name.lower())
+        said = question(synonym) if synonym else (
+            did_you_mean(name, self.list_commands(ctx)) if len(name) <= 40 else "")
+        return f" {said[:1].upper()}{said[1:]}" if said else ""  # a sentence, as click's own
 
     def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
         if name in self.LAZY:

@@ -14,7 +14,7 @@ import os
 import re
 import sys
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from mercmac.commands import MAX_INT32
 from mercmac.cli.common import UsageError, opened, say
@@ -52,6 +52,7 @@ class Request:
     fail_on_hazard: bool = False
     hold: str = ""  # --interactive: inputs held at power-on, e.g. "2" or "2+3"
     joystick: str = ""  # a rig: NAME=D@T1-T2,...
+    allow_hazard: tuple[str, ...] = ()  # hazard rules accepted for the run
 
 
 @dataclass(frozen=True, slots=True)
@@ -105,7 +106,7 @@ def _run(req: Request) -> bool:
             raise UsageError("--plot does not go with --interactive (a live session has no end to draw)")
         _check_plot(req.plot)
     options = Options(servo_on=not req.servo_off, reference_at=req.reference_at,
-                      hard_limits=_limits(req.hard_limits))
+                      hard_limits=_limits(req.hard_limits), accepted=_allowed(req.allow_hazard))
     accepted = opened(rig_file.accepted if rig_file else _lone(req))
     if accepted is None:
         return False
@@ -121,6 +122,17 @@ def _run(req: Request) -> bool:
     if result.interrupted:  # Ctrl-C: the timeline so far and the summary, then exit 128+N
         raise interrupt(result.interrupted)
     return _hazards_ok(req, result.hazards)
+
+
+def _allowed(keys: tuple[str, ...]) -> frozenset[str]:
+    """--allow-hazard: the hazard rules named (mercmac/hazards.py); a name that is no hazard rule
+    is a usage error with the nearest."""
+    from mercmac.hazards import accepted_rules
+
+    try:
+        return accepted_rules(keys, "--allow-hazard")
+    except ValueError as e:
+        raise UsageError(str(e)) from None
 
 
 def _lone(req: Request):
@@ -210,6 +222,7 @@ def _scenario(req: Request, rig: Rig, programs: dict, script: Script,
     from mercmac.sim import scenario
 
     plan = scenario.load(req.scenario)
+    options = replace(options, accepted=options.accepted | plan.accepted)
     until = _until(req.until, plan.until_ms)
     with _views(req, rig) as views:
         sim = _simulation(req, rig, programs, script, options, views.listeners())
@@ -404,6 +417,7 @@ def _deflection(rig: Rig, item: str):
                          "e.g. x=+0.5@1s-3s (D from -1 to 1)")
     who, value, start, end = m.groups()
     name = rig.joystick.get(who, who)  # a branch names its controller
+    _branch_known(rig, who, item)
     _known(rig, name, "--joystick", item)
     if name not in rig.joystick.values():
         raise UsageError(f"--joystick '{item}': no joystick branch goes to {name}; the rig's "
@@ -418,6 +432,21 @@ def _deflection(rig: Rig, item: str):
     if t1 is not None and t1 < t0:
         raise UsageError(f"--joystick '{item}': the end is before the start")
     return Hold(name, deflection, t0, t1)
+
+
+def _branch_known(rig: Rig, who: str, item: str) -> None:
+    """UsageError for a branch (X, Y, Z) the rig's [joystick] table does not connect, unless
+    a controller is called so: said as a missing branch, not a missing controller."""
+    from mercmac.rig.load import BRANCHES
+
+    if who not in BRANCHES or who in rig.joystick or any(c.name == who for c in rig.controllers):
+        return
+    has = ", ".join(f"{b} = \"{n}\"" for b, n in rig.joystick.items())
+    why = (f"the rig's [joystick] table has no branch {who} (only {has})" if has else
+           f"{who} is a joystick branch, and the rig has no [joystick] table to say which "
+           "controller it goes to")
+    raise UsageError(f"--joystick '{item}': {why}",
+                     hint=f"add {who} = \"NAME\" under [joystick] in the rig file")
 
 
 def _until(text: str | None, fallback: int | None) -> int:

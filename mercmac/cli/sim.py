@@ -47,6 +47,10 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
               help="Timed button steps and expectations; exit 1 on the first that fails. "
                    "Not with --buttons: the scenario's steps are the button script.")
 @click.option("--fail-on-hazard", is_flag=True, help="Exit 1 when the run finds any hazard (for CI).")
+@click.option("--allow-hazard", "allow", multiple=True, metavar="RULES",
+              help="Accept these hazard rules for the run (codes or names, comma-separated or "
+                   "repeated), e.g. soft-limit-clamp for jogs that stop at the soft limits: "
+                   "shown as accepted, not counted by --fail-on-hazard.")
 @click.option("--target", type=MODEL_CHOICE, help="Controller model; overrides the file's `target`.")
 @click.option("--cycle", type=FiniteFloat(), default=1.0, show_default=True, metavar="MS",
               help="Time one executed command takes.")
@@ -58,7 +62,7 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
 @click.option("--hard-limits", default=None, metavar="NEG,POS",
               help="Positions of the limit switches, e.g. -200000,200000 (default: none).")
 def sim(file, buttons, joystick, until, fmt, verbose, trace, vcd, vcd_limit, plot, interactive, hold, speed, scenario,
-        fail_on_hazard, target, cycle, servo_off, reference_at, hard_limits) -> None:
+        fail_on_hazard, allow, target, cycle, servo_off, reference_at, hard_limits) -> None:
     """Simulate FILE on a virtual controller with a scripted pushbutton box; a rig file
     (*.rig.toml) runs every controller on one clock (--buttons NAME:B@T1-T2).
 
@@ -74,7 +78,7 @@ def sim(file, buttons, joystick, until, fmt, verbose, trace, vcd, vcd_limit, plo
             interactive=interactive, speed=speed, scenario=scenario, target=target,
             cycle_ms=cycle, servo_off=servo_off, reference_at=reference_at,
             hard_limits=hard_limits, fail_on_hazard=fail_on_hazard, hold=hold,
-            verbose=verbose, joystick=joystick)
+            verbose=verbose, joystick=joystick, allow_hazard=allow)
         return EXIT_OK if run.run(request) else EXIT_FAILED
 
     run_guarded(work)

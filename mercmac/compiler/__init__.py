@@ -33,6 +33,7 @@ def compile_source(source: Source, target: str | None = None) -> Compilation:
     from mercmac.compiler.program_checks import check_program
     from mercmac.compiler.lower import lower
     from mercmac.compiler.parse import paused_gc
+    from mercmac.suppress import expected_hazards
 
     report = Report(source.name)
     parsed = parse_module(source.text, report)
@@ -47,6 +48,7 @@ def compile_source(source: Source, target: str | None = None) -> Compilation:
         env = check_module(module, report, model)
     program = lower(module, env, report, source.name)
     check_program(program, report)
+    program.expected = expected_hazards(source)
     return Compilation(source, report, program)
 
 

@@ -12,10 +12,11 @@ from mercmac.commands import MODELS, Arg, lookup
 from mercmac.compiler import ast
 from mercmac.compiler.parse import BROKEN, keyword_candidates
 from mercmac.compiler.program import MAX_RP, MAX_WA, MAX_WAITS, SLOTS, rp_counts
+from mercmac.compiler.sampling import check_loops
 from mercmac.ops import Op
 from mercmac.diagnostics import DISPLAY_ONLY, SAFE, UNSAFE, Applicability, Fix, Report
 from mercmac.source import Span
-from mercmac.suggest import candidates
+from mercmac.suggest import candidates, question
 
 MAX_REPEAT = MAX_RP + 1  # `repeat N` lowers to RP N-1; MS176E §6.4 RP: n <= 32568
 MAX_PERIOD_MS = MAX_WA * MAX_WAITS  # `every T` lowers to WA T, several WAs past 65535 ms
@@ -33,6 +34,8 @@ class Env:
         self.macros: dict[str, ast.MacroDef] = {}
         self.ops: dict[ast.Command, Op] = {}
         self.values: dict[ast.Value, int] = {}
+        # `repeat`/`every` blocks that hold a `when`: timed once the file is checked (slow-poll)
+        self.polls: list[ast.Repeat | ast.Every] = []
 
 
 def check_module(module: ast.Module, report: Report, target: str | None,
@@ -58,6 +61,8 @@ def check_module(module: ast.Module, report: Report, target: str | None,
             elif item.pin is not None:
                 _claim_slot(item.pin.value, item.pin.span, f"macro {item.pin.value}", slots, report)
             _block(item.body, env, report)
+    if env.polls:
+        check_loops(env.polls, env, report)
     return env
 
 
@@ -97,7 +102,9 @@ def _claim_slot(slot: int, span: Span, what: str, slots: dict[int, Span], report
         slots[slot] = span
 
 
-def _block(body: tuple, env: Env, report: Report) -> None:
+def _block(body: tuple, env: Env, report: Report) -> bool:
+    """Check a block; whether a `when` stands in it outside the loops it holds."""
+    reads = False
     for i, stmt in enumerate(body):
         if isinstance(stmt, ast.Command):
             _command(stmt, env, report, raw=False)
@@ -109,16 +116,20 @@ def _block(body: tuple, env: Env, report: Report) -> None:
             for c in stmt.conditions:
                 _bounded(c.value, env, report, INPUTS, "when")
             _block(stmt.body, env, report)
+            reads = True
         elif isinstance(stmt, ast.Repeat):
             _repeat_count(stmt, env, report)
             _loop_goto(stmt, "repeat", report)
-            _block(stmt.body, env, report)
+            if _block(stmt.body, env, report):
+                env.polls.append(stmt)
         elif isinstance(stmt, ast.Every):
             if _bounded(stmt.period, env, report, range(0, MAX_PERIOD_MS + 1), "every",
                         max=MAX_PERIOD_MS, wa=MAX_WA) == 0:
                 report.add("every-zero", stmt.span)
             _loop_goto(stmt, "every", report)
-            _block(stmt.body, env, report)
+            if _block(stmt.body, env, report):
+                env.polls.append(stmt)
+    return reads
 
 
 def _repeat_count(stmt: ast.Repeat, env: Env, report: Report) -> None:
@@ -179,7 +190,7 @@ def _nearest(name: str, known) -> tuple[str | None, Applicability]:
 
 def _did_you_mean(meant: str | None) -> str:
     """What a message ends with for a word `meant` instead of the one written."""
-    return f"; did you mean '{meant}'?" if meant else ""
+    return f"; {question(meant)}" if meant else ""
 
 
 def _fix(span: Span, meant: str | None, sure: Applicability) -> Fix | None:
@@ -212,10 +223,13 @@ def _resolve(value: ast.Value, env: Env, report: Report) -> int | None:
         else:
             meant, sure = _nearest(value.name, env.consts)
             report.add("undefined-name", value.span, "const", name=value.name,
-                       hint=_did_you_mean(meant), fix=_fix(value.span, meant, sure))
+                       hint=_did_you_mean(meant), fix=_fix(value.name_span, meant, sure))
         return None
-    env.values[value] = env.consts[value.name]
-    return env.consts[value.name]
+    number = env.consts[value.name]
+    if value.sign == "-" and number is not None:  # `MR -FAR`: range-checked as -5000 would be
+        number = -number
+    env.values[value] = number
+    return number
 
 
 def _command(cmd: ast.Command, env: Env, report: Report, *, raw: bool) -> None:

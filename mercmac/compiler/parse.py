@@ -38,6 +38,7 @@ _NESTED = ("when", "repeat", "every")
 _TERMINALS = {
     "_NL": "end of line", "COMMA": "','", "LBRACE": "'{'", "RBRACE": "'}'", "AT": "'@'",
     "EQUAL": "'='", "MNEMONIC": "a command", "NAME": "a name", "INT": "a number",
+    "SIGNED_NAME": "a signed name such as -FAR",
     "RAW_HEADER": "[MCnn]", "MODEL": "C-663 or C-863", "DURATION": "a duration such as 20ms",
     "$END": "end of file", "NOT": "'not'", "AND": "'and'", "MACRO": "'macro'",
     "TARGET": "'target'", "CONST": "'const'", "AUTOSTART": "'autostart'", "WHEN": "'when'",

@@ -5,6 +5,8 @@ show macro names, not numbers, through `Macro.name` and the spans of `Op`.
 """
 from __future__ import annotations
 
+from typing import Mapping
+
 from mercmac import mdtext
 from mercmac.ops import Op, Origin
 from mercmac.source import Span
@@ -71,16 +73,48 @@ class Macro:
         tag = mdtext.slot_name(self.slot)
         return tag if self.name == tag else f"{self.name} ({tag})"
 
+    @property
+    def written(self) -> str:
+        """How a diagnostic names it: the label, but a macro the compiler made by the block
+        the user wrote, 'the `repeat` at line 30 (MC03)' (see `as_written`)."""
+        if "." not in self.name:
+            return self.label
+        return f"{as_written(self.name)} ({mdtext.slot_name(self.slot)})"
+
+
+_BLOCKS = ("when", "repeat", "every")
+
+
+def as_written(name: str) -> str:
+    """A macro's name in the user's terms. Compiler-made names (lower.py `helper`,
+    `part_name`) are the owner's name and a step, 'jog.when@29.repeat@30', 'jog.rest@31',
+    'jog.part2': no user wrote them, so a block is named by its kind and line, a rest by
+    the user's macro and the line it starts at, a part by what it is a part of."""
+    owner, _, step = name.rpartition(".")
+    if not owner:
+        return name  # a user's macro, 'autostart' or 'MC05': names have no '.'
+    kind, _, where = step.partition("@")
+    line, _, column = where.partition(":")
+    at = f"line {line}, column {column}" if column else f"line {line}"
+    if kind in _BLOCKS:
+        return f"the `{kind}` at {at}"
+    if kind == "rest":
+        return f"the rest of {name.partition('.')[0]} from {at}"
+    return f"part {step.removeprefix('part')} of {as_written(owner)}"
+
 
 class Program:
     """All macros of one compiled file, by slot."""
 
-    __slots__ = ("macros", "target", "file", "inlined")
+    __slots__ = ("macros", "target", "file", "inlined", "expected")
 
     def __init__(self, macros: dict[int, Macro], target: str | None = None, file: str = "",
-                 inlined: frozenset = frozenset()):
+                 inlined: frozenset = frozenset(),
+                 expected: Mapping[int, frozenset[str]] | None = None):
         self.macros, self.target, self.file = macros, target, file
         self.inlined = inlined  # named macros whose body also runs in place of a call
+        # hazard rules a line's `// mercmac: expect[...]` accepts, by line (mercmac.suppress)
+        self.expected: Mapping[int, frozenset[str]] = expected or {}
 
     def __repr__(self) -> str:
         return f"Program({self.macros!r}, target={self.target!r}, file={self.file!r})"

@@ -114,6 +114,30 @@ def runs(line: Line, lines: dict[int, Line]) -> Runs | None:
     return Runs(times, ms, not ends)
 
 
+def idle_pass_ms(line: Line, lines: dict[int, Line]) -> int | None:
+    """How long one pass of a loop line takes while no input is on: its commands up to the
+    first RP (which jumps back), a call costing its EM and the condition the called macro
+    starts with, which is false and ends it (MS176E §6.4 XN). None when a command's time is
+    the machine's to decide. A `when` in the loop samples its input once a pass: a press
+    shorter than this may be missed (docs/simulator.md, "Conditions")."""
+    ms = 0
+    for op in line.ops or ():
+        if op.mnemonic == Mnemonic.EM:
+            callee = lines.get(op.arg)
+            starts = callee is not None and callee.ops and callee.ops[0].mnemonic == Mnemonic.XN
+            if not starts:  # (a false XN ends it: what it would call never runs)
+                return None
+            ms += 2 * CYCLE_MS
+        else:
+            took = _command_ms(op)
+            if took is None:
+                return None
+            ms += took
+        if op.mnemonic == Mnemonic.RP:
+            return ms
+    return None
+
+
 def _repeat_count(op) -> int:
     """How often an `RP n` lets the line pass it: n + 1 (a bare RP is RP65535;
     docs/simulator.md, "Repeat counters")."""

@@ -4,15 +4,13 @@ from __future__ import annotations
 
 import json
 
-from mercmac.commands import C663, Mnemonic, lookup
+from mercmac.commands import Mnemonic, lookup, unit
 from mercmac.mdtext import slot_name
 from mercmac.names import dot, markdown, mermaid, printable
 from mercmac.render.sim import plural
 from mercmac.timespec import format_span
-from mercmac.decompile.lines import (Line, condition_run, every_period, model_of, names,
-                                     read_lines, runs)
-
-_UNITS = {C663: "steps"}  # MS176E §3: the C-663 counts microsteps, the C-863 encoder counts
+from mercmac.decompile.lines import (Line, condition_run, every_period, idle_pass_ms, model_of,
+                                     names, read_lines, runs)
 
 
 class Reader:
@@ -20,14 +18,16 @@ class Reader:
 
     def __init__(self, macros: dict[int, str], model: str | None,
                  given: dict[int, str] | None = None, inputs: dict[int, str] | None = None,
-                 outputs: dict[int, str] | None = None):
+                 outputs: dict[int, str] | None = None, box: bool = True):
         self.lines = read_lines(macros)
         # I/O lines that a rig wires to another controller, by number: 'input 2 (from
         # y.out2)', 'output 1 (to y.in1)'; the others are the box's buttons and LEDs
-        # (MS176E §4.5.1).
-        self.inputs, self.outputs = inputs or {}, outputs or {}
+        # (MS176E §4.5.1), or, on a controller without the box (`box` false), plain
+        # inputs and outputs.
+        self.inputs, self.outputs, self.box = inputs or {}, outputs or {}, box
         self.model = model_of(self.lines, model)
-        self.unit = _UNITS.get(self.model, "counts") if self.model else "counts"
+        self.unit = unit(self.model)
+        self.limits = _soft_limits(self.lines)
         # The source's names, as `sim` and `flash` show them (Macro.label); a raw slot's
         # name is its tag, and it gets a name made from what it does instead.
         self.given = {s: n for s, n in (given or {}).items() if n != slot_name(s)}
@@ -37,7 +37,7 @@ class Reader:
     def condition(self, run) -> str:
         """The XN/XF of `run` in words: buttons held or not, wired inputs on or off."""
         buttons = [o for o in run if o.arg not in self.inputs]
-        parts = [_condition(buttons)] if buttons else []
+        parts = [_condition(buttons, self.box)] if buttons else []
         parts += [f"{self.inputs[o.arg]} is {'on' if o.mnemonic == Mnemonic.XN else 'off'}"
                   for o in run if o.arg in self.inputs]
         return " and ".join(parts)
@@ -100,9 +100,9 @@ class Reader:
             when = f" if {self.condition(run)}" if run and len(run) < len(target.ops) else ""
             return ("go to " if tail else "run ") + self.label(n) + when
         if m == Mnemonic.MR:
-            return f"move {n:+,} {unit}"
+            return f"move {n:+,} {unit}" + self._limited(n, relative=True)
         if m == Mnemonic.MA:
-            return f"move to position {n:,}"
+            return f"move to position {n:,}" + self._limited(n, relative=False)
         if m == Mnemonic.GH:
             return "go home (position 0)"
         if m == Mnemonic.DH:
@@ -119,18 +119,40 @@ class Reader:
             return f"wait until on target and {1000 if n is None else n} ms more"
         if m in (Mnemonic.WF, Mnemonic.WN) and n in self.inputs:
             return f"wait until {self.inputs[n]} is {'off' if m == Mnemonic.WF else 'on'}"
+        if m in (Mnemonic.WF, Mnemonic.WN) and not self.box:
+            return f"wait until input {n} is {'off' if m == Mnemonic.WF else 'on'}"
         if m in (Mnemonic.WF, Mnemonic.WN):
             return f"wait until button {n} is {'released' if m == Mnemonic.WF else 'pressed'}"
         if m == Mnemonic.CP:
-            return _leds(n)
+            return _leds(n, self.box)
         if m in (Mnemonic.CN, Mnemonic.CF):
-            return f"{self.outputs.get(n, f'LED {n}')} {'on' if m == Mnemonic.CN else 'off'}"
+            return f"{self.output(n)} {'on' if m == Mnemonic.CN else 'off'}"
         if m == Mnemonic.RP:
             return f"repeat the line {plural(65535 if n is None else n, 'more time')}"
         if m == Mnemonic.FE:
             return f"search the reference (FE{0 if n is None else n})"
         summary = lookup(m).summary.split(":")[0].split(" (")[0]
         return f"{summary[0].lower()}{summary[1:]} ({op.text})"
+
+    def output(self, n: int) -> str:
+        """Output line n in words: its wire, the box's LED, or a plain output."""
+        return self.outputs.get(n, f"LED {n}" if self.box else f"output {n}")
+
+    def _limited(self, n: int, relative: bool) -> str:
+        """What stops a move the soft limits clamp (MS176E §4.4.2): a jog far past them
+        (`MR 9999999` against JH 20000) ends at the limit, wherever it starts."""
+        low, high = self.limits
+        if relative:
+            span = None if low is None or high is None else high - low
+            side, limit = ("upper", high) if n > 0 else ("lower", low)
+            if limit is None or span is None or abs(n) < span:
+                return ""
+            return f" (a jog: the {side} soft limit, {limit:,}, stops it)"
+        if high is not None and n > high:
+            return f" (the upper soft limit stops it at {high:,})"
+        if low is not None and n < low:
+            return f" (the lower soft limit stops it at {low:,})"
+        return ""
 
     # -- the program ----------------------------------------------------------------------------------
     def reached(self) -> set[int]:
@@ -154,19 +176,32 @@ class Reader:
             todo += self.lines[s].ems()
         return seen
 
-    def modes(self) -> list[dict]:
-        """Loops entered by a tail EM of a line that a button selects."""
+    def modes(self, ending: bool = False) -> list[dict]:
+        """Loops entered by a tail EM of a line that a button selects; with `ending`, the
+        other targets of such a goto: macros that stop the program (an abort that ends in
+        direct mode is no mode)."""
         out = []
         for line in self.lines.values():
             run = condition_run(line.ops)
             if run and line.ops[-1].mnemonic == Mnemonic.EM:
                 target = line.ops[-1].arg
-                if target in self.lines:
+                if target in self.lines and self.goes_on(target) != ending:
                     out.append({"mode": target, "name": self.names[target], "by": line.slot,
                                 "condition": self.condition(run),
                                 "first": self.phrase(list(line.ops[len(run):-1]), line) or "",
                                 "at_power_on": line.slot in self.startup()})
         return out
+
+    def goes_on(self, slot: int, seen: frozenset = frozenset()) -> bool:
+        """Whether running `slot` keeps the program running: it loops (RP), or goes on to
+        another macro (a tail EM) that does; a macro that ends ends the program (§3.8.4)."""
+        ops = self.lines[slot].ops or ()
+        if slot in seen or any(op.mnemonic == Mnemonic.RP for op in ops):
+            return True
+        tail = ops[-1] if ops else None
+        if tail is None or tail.mnemonic != Mnemonic.EM or tail.arg not in self.lines:
+            return False
+        return self.goes_on(tail.arg, seen | {slot})
 
     def loops(self) -> list[dict]:
         out = []
@@ -182,14 +217,25 @@ class Reader:
                     answers.append({"slot": target, "condition": self.condition(run),
                                     "does": self.phrase(list(t.ops[len(run):]), t)})
             out.append({"slot": line.slot, "name": self.names[line.slot], "period_ms": period,
-                        "answers": answers})
+                        "pass_ms": idle_pass_ms(line, self.lines), "answers": answers})
         return out
 
     def leds(self) -> list[dict]:
+        """What each macro does to the LEDs (or outputs): on, off, and a pulse as one (CN n,
+        WA t, CF n: on for t ms, then off again)."""
         out = []
         for line in self.lines.values():
-            lit = [_leds(op.arg) if op.mnemonic == Mnemonic.CP else self.command(op, tail=False)
-                   for op in line.ops or () if op.mnemonic in (Mnemonic.CP, Mnemonic.CN)]
+            ops, lit, i = line.ops or (), [], 0
+            while i < len(ops):
+                op = ops[i]
+                if _pulse(ops, i):
+                    lit.append(f"{self.output(op.arg)} on for {ops[i + 1].arg:,} ms, then off "
+                               "again (a pulse)")
+                    i += 3
+                    continue
+                if op.mnemonic in (Mnemonic.CP, Mnemonic.CN, Mnemonic.CF):
+                    lit.append(self.command(op, tail=False))
+                i += 1
             if lit:
                 out.append({"slot": line.slot, "name": self.names[line.slot], "lights": lit})
         return out
@@ -200,7 +246,8 @@ class Reader:
             "model": self.model, "unit": self.unit,
             "power_on": ({"slot": 0, "does": self.words(self.lines[0])}
                          if 0 in self.lines else None),
-            "modes": self.modes(), "loops": self.loops(), "leds": self.leds(),
+            "modes": self.modes(), "ends": self.modes(ending=True), "loops": self.loops(),
+            "leds": self.leds(), "box": self.box,
             "unreached": [s for s in self.lines if s not in reached and 0 in self.lines],
             "macros": [{"slot": s, "name": self.names[s], "line": line.text,
                         "does": self.words(line), "calls": line.ems(),
@@ -225,25 +272,48 @@ def _length(ms: int) -> str:
     return exact if len(exact) <= len(rounded) else f"about {rounded}"
 
 
-def _condition(run, at_start: bool = False) -> str:
+def _soft_limits(lines: dict[int, Line]) -> tuple[int | None, int | None]:
+    """The lower and upper soft limit the program sets (JL, JH; MS176E §4.4.2), each when
+    it sets one value only."""
+    found = {Mnemonic.JL: set(), Mnemonic.JH: set()}
+    for line in lines.values():
+        for op in line.ops or ():
+            if op.mnemonic in found and op.arg is not None:
+                found[op.mnemonic].add(op.arg)
+    low, high = found[Mnemonic.JL], found[Mnemonic.JH]
+    return (next(iter(low)) if len(low) == 1 else None,
+            next(iter(high)) if len(high) == 1 else None)
+
+
+def _pulse(ops, i: int) -> bool:
+    """Whether ops[i:i+3] is CN n, WA t, CF n: output n on for t ms."""
+    return (i + 2 < len(ops) and ops[i].mnemonic == Mnemonic.CN
+            and ops[i + 1].mnemonic == Mnemonic.WA and ops[i + 1].arg is not None
+            and ops[i + 2].mnemonic == Mnemonic.CF and ops[i + 2].arg == ops[i].arg)
+
+
+def _condition(run, box: bool = True) -> str:
+    """'button 1 is held', or on a controller without the box 'input 1 is on'."""
     on = [str(o.arg) for o in run if o.mnemonic == Mnemonic.XN]
     off = [str(o.arg) for o in run if o.mnemonic == Mnemonic.XF]
+    what, held, free = ("button", "held", "not pressed") if box else ("input", "on", "off")
     parts = []
     if on:
-        parts.append(f"button {on[0]} is held" if len(on) == 1
-                     else f"buttons {' and '.join(on)} are held")
+        parts.append(f"{what} {on[0]} is {held}" if len(on) == 1
+                     else f"{what}s {' and '.join(on)} are {held}")
     if off:
-        parts.append(f"button {off[0]} is not pressed" if len(off) == 1
-                     else f"buttons {' and '.join(off)} are not pressed")
-    return " and ".join(parts).replace("button 5", "the joystick input").replace(
-        "button 6", "the joystick button")
+        parts.append(f"{what} {off[0]} is {free}" if len(off) == 1
+                     else f"{what}s {' and '.join(off)} are {free}")
+    return " and ".join(parts).replace(f"{what} 5", "the joystick input").replace(
+        f"{what} 6", "the joystick button")
 
 
-def _leds(pattern: int) -> str:
+def _leds(pattern: int, box: bool = True) -> str:
     lit = [str(i + 1) for i in range(4) if pattern >> i & 1]
+    one, many = ("LED", "LEDs") if box else ("output", "outputs")
     if not lit:
-        return "all LEDs off"
-    return (f"LED {lit[0]}" if len(lit) == 1 else f"LEDs {', '.join(lit[:-1])} and {lit[-1]}") \
+        return f"all {many} off"
+    return (f"{one} {lit[0]}" if len(lit) == 1 else f"{many} {', '.join(lit[:-1])} and {lit[-1]}") \
         + " on, the others off"
 
 
@@ -258,11 +328,13 @@ def _series(steps: list[str]) -> str:
 
 def describe(macros: dict[int, str], *, model: str | None = None, fmt: str = "text",
              names: dict[int, str] | None = None, level: int = 1,
-             inputs: dict[int, str] | None = None, outputs: dict[int, str] | None = None) -> str:
+             inputs: dict[int, str] | None = None, outputs: dict[int, str] | None = None,
+             box: bool = True) -> str:
     """The program in words; `names`: the source's macro names by slot (Program.names());
     `level`: the markdown heading level of its title (a rig's programs are sections);
-    `inputs`, `outputs`: words for the lines a rig wires, by number (Reader.inputs)."""
-    reader = Reader(macros, model, names, inputs, outputs)
+    `inputs`, `outputs`: words for the lines a rig wires, by number (Reader.inputs); `box`:
+    whether the controller has the pushbutton box (its inputs are buttons, outputs LEDs)."""
+    reader = Reader(macros, model, names, inputs, outputs, box)
     data = reader.data()
     if fmt == "json":
         return json.dumps(data, indent=2, ensure_ascii=False) + "\n"
@@ -283,9 +355,9 @@ def describe(macros: dict[int, str], *, model: str | None = None, fmt: str = "te
 
 def described(macros: dict[int, str], *, model: str | None = None,
               names: dict[int, str] | None = None, inputs: dict[int, str] | None = None,
-              outputs: dict[int, str] | None = None) -> dict:
+              outputs: dict[int, str] | None = None, box: bool = True) -> dict:
     """What `describe --format json` prints, as data (a rig's JSON holds one per program)."""
-    return Reader(macros, model, names, inputs, outputs).data()
+    return Reader(macros, model, names, inputs, outputs, box).data()
 
 
 def _item(depth: int, text: str, md: bool) -> str:
@@ -315,17 +387,33 @@ def _sections(reader: Reader, data: dict) -> list[tuple[str, list[tuple[int, str
             f"{m['condition']}{when} (through {label(m['by'])}{first})")
     modes = [f"{label(mode)}: chosen while " + "; or while ".join(how)
              for mode, how in ways.items()]
+    ends = [f"{label(m['mode'])}: while {m['condition']} (through {label(m['by'])}), "
+            f"{reader.phrase(list(reader.lines[m['mode']].ops or ()), reader.lines[m['mode']]) or 'nothing'}"
+            "; then the program ends (direct mode)" for m in data["ends"]]
     loops = []
     for loop in data["loops"]:
-        loops.append((0, f"{label(loop['slot'])}: every {loop['period_ms']} ms"))
+        loops.append((0, f"{label(loop['slot'])}: every {loop['period_ms']} ms"
+                      + _pass(loop["pass_ms"], reader.box)))
         loops += [(1, f"while {a['condition']}, {label(a['slot'])}: {a['does']}")
                   for a in loop["answers"]]
     leds = [f"{label(x['slot'])}: " + "; ".join(x["lights"]) for x in data["leds"]]
     every = [f"{label(m['slot'])}: {m['does']}" for m in data["macros"]]
     never = [f"{label(s)}" for s in data["unreached"]]
-    return [("At power-on", _top(power)), ("Modes chosen by buttons", _top(modes)),
-            ("Polling loops and the buttons they answer", loops), ("LEDs", _top(leds)),
+    by = "buttons" if reader.box else "inputs"
+    return [("At power-on", _top(power)), (f"Modes chosen by {by}", _top(modes)),
+            (f"Stops chosen by {by}", _top(ends)),
+            (f"Polling loops and the {by} they answer", loops),
+            ("LEDs" if reader.box else "Outputs", _top(leds)),
             ("Every macro", _top(every)), ("Never reached from macro 0", _top(never))]
+
+
+def _pass(ms: int | None, box: bool) -> str:
+    """How long a pass takes with nothing held: a `when` in the loop sees its input once a
+    pass, so a shorter press may be missed (docs/simulator.md, "Conditions")."""
+    if ms is None:
+        return ""
+    what = "a button must be held" if box else "an input must stay on"
+    return f"; a pass takes {ms:,} ms with nothing held, so {what} at least that long to be seen"
 
 
 def _top(texts: list[str]) -> list[tuple[int, str]]:

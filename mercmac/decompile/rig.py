@@ -34,6 +34,7 @@ class Stored(NamedTuple):
     names: dict[int, str]
     inputs: dict[int, str] = {}
     outputs: dict[int, str] = {}
+    box: bool = True  # the C-170.PB box is on its I/O socket: inputs are buttons, outputs LEDs
 
 
 class Touch(NamedTuple):
@@ -73,7 +74,8 @@ def _wired(rig, programs: Mapping[str, Stored]) -> dict[str, Stored]:
                 outputs.setdefault(w.source.number, f"output {w.source.number} (to")
                 outputs[w.source.number] += f" {w.target}"
         out[c.name] = programs[c.name]._replace(
-            inputs=inputs, outputs={n: f"{text})" for n, text in outputs.items()})
+            inputs=inputs, outputs={n: f"{text})" for n, text in outputs.items()},
+            box=rig.box == c.name)
     return out
 
 
@@ -116,7 +118,7 @@ def _markdown(rig, programs, readers) -> str:
 
 def _described_as(stored: Stored, fmt: str, level: int = 1) -> str:
     return describe(stored.macros, model=stored.model, names=stored.names, fmt=fmt, level=level,
-                    inputs=stored.inputs, outputs=stored.outputs)
+                    inputs=stored.inputs, outputs=stored.outputs, box=stored.box)
 
 
 def _rig_sections(rig, readers) -> list[tuple[str, list[tuple[int, str]]]]:
@@ -165,7 +167,7 @@ def _data(rig, programs, readers) -> dict:
                          "program": c.program, "description": described(
                              programs[c.name].macros, model=programs[c.name].model,
                              names=programs[c.name].names, inputs=programs[c.name].inputs,
-                             outputs=programs[c.name].outputs)}
+                             outputs=programs[c.name].outputs, box=programs[c.name].box)}
                         for c in rig.controllers],
         "wires": [{"from": str(w.source), "to": str(w.target),
                    "set_by": [_touch(t) for t in touches(readers, w.source, _SETS)],

@@ -14,6 +14,7 @@ import math
 from itertools import islice
 from typing import IO, Iterator
 
+from mercmac.commands import unit
 from mercmac.mdtext import slot_name
 from mercmac.names import printable
 from mercmac.render import jsontext
@@ -57,16 +58,21 @@ def _where(where: ev.Where | None) -> str:
     return f"  [{where.label}, line {where.line}]" if where.line else f"  [{where.label}]"
 
 
-def event_line(event) -> Line | None:
-    """One timeline entry as a styled line; None for what the timeline does not show."""
+def event_line(event, unit: str = "counts") -> Line | None:
+    """One timeline entry as a styled line; None for what the timeline does not show.
+    `unit`: what the controller's distances count in (commands.unit: steps on a C-663)."""
     match event:
         case ev.InputChanged(t, n, on):
             name = {5: "joystick", 6: "joystick button"}.get(n, f"button {n}")
             return at(t) + [(f"{name} {'pressed' if on else 'released'}", "bold cyan")]
+        case ev.JoystickMoved(t):
+            return at(t) + [(_stick(event, unit), "bold cyan")]
         case ev.OutputsChanged(t, pattern):
             return at(t) + [("LEDs ", "")] + lamps(pattern)
         case ev.Reported(t, text, where):
             return at(t) + [("report ", ""), (text, "bold"), (_where(where), "dim")]
+        case ev.HazardFound(t, rule, message, where, True):
+            return at(t) + [(f"accepted {rule}: ", "yellow"), (message, ""), (_where(where), "dim")]
         case ev.HazardFound(t, rule, message, where):
             return at(t) + [(f"hazard {rule}: ", "bold red"), (message, "red"), (_where(where), "dim")]
         case ev.MoveStarted(t, kind, target, arrival, segments, where):
@@ -84,7 +90,8 @@ def event_line(event) -> Line | None:
             kind = ("identical pass", "identical passes") if not shift else ("pass", "passes")
             whose = "the target " if event.steady else ""  # (the stage runs on its profile)
             moved = (f", {whose or 'each '}{'+' if shift > 0 else '-'}"
-                     f"{plural(abs(shift), 'count')} further{' each' if whose else ''}"
+                     f"{plural(abs(shift), unit.removesuffix('s'))} further"
+                     f"{' each' if whose else ''}"
                      if shift else "")
             return at(t) + [(f"fast-forward {plural(passes, *kind)} of {loop.label} "
                               f"({format_span(period)}{_emitted(shape)} each{moved}) "
@@ -92,6 +99,24 @@ def event_line(event) -> Line | None:
         case Folded():
             return _folded(event)
     return None
+
+
+# MS176E §6.4 JT: the predefined response tables, by number
+JOYSTICK_TABLES = {0: "linear", 1: "cubic", 2: "inverted linear", 3: "inverted cubic"}
+
+
+def _stick(e: ev.JoystickMoved, unit: str = "counts") -> str:
+    """'joystick at +0.50 (input 5 ON): commands +1,000 counts/s (JN 8000, cubic table)': the
+    deflection and the velocity it commands (MS176E §3.6.1); the input 5 change it makes is
+    said here, not on a line of its own (_story)."""
+    where = f"at {e.deflection:+.2f}" if e.deflection else "back in the middle"
+    head = f"joystick {where} (input 5 {'ON' if e.input_on else 'OFF'}): "
+    if not e.maximum:
+        return head + "commands nothing, joystick control is off (no JN)"
+    v = e.velocity
+    speed = "0" if not v else f"{v:+,.0f}" if abs(v) >= 1 else f"{v:+.2g}"
+    table = JOYSTICK_TABLES.get(e.table, f"table {e.table}")
+    return head + f"commands {speed} {unit}/s (JN {e.maximum}, {table} table)"
 
 
 def _move(t: int, kind: ev.Motion, target: int, arrival: float, segments: tuple) -> str:
@@ -205,16 +230,21 @@ def at(t_us: float) -> Line:
     return [(f"{clock(t_us):>16}  ", "dim")]
 
 
-def _story(events: list, level: int) -> Iterator[tuple[int, Line]]:
+def _story(events: list, level: int, unit: str = "counts") -> Iterator[tuple[int, Line]]:
     """The shown lines, dated: other events as they come, each stretch of folds sorted."""
     folds: list[Folded] = []
+    stick = None  # the joystick move just shown: its line says the input 5 change it made
     for event in events:
         if isinstance(event, Folded):
             folds.append(event)
             continue
+        if type(event) is ev.InputChanged and event.input == 5 and stick is not None \
+                and stick.t == event.t:
+            continue
+        stick = event if type(event) is ev.JoystickMoved else None
         yield from _stretch(folds, level)
         folds = []
-        line = event_line(event)
+        line = event_line(event, unit)
         if line is not None:
             yield event.t, line
     yield from _stretch(folds, level)
@@ -253,13 +283,14 @@ def timeline(result: Result, level: int = 0) -> list[Line]:
 def _named(result: Result, name: str, events: list, level: int) -> Iterator[tuple[int, Line]]:
     """One controller's dated lines; in a rig of several, its name after the time and its
     wired inputs left out (the wires' edges show them)."""
+    distance = unit(result.runs[name].machine.model)
     if not result.rig.several:
-        yield from _story(events, level)
+        yield from _story(events, level, distance)
         return
     wired = {w.target.number for w in result.rig.wires if w.target.controller == name}
     shown = [e for e in events if not (type(e) is ev.InputChanged and e.input in wired)]
     width = _width(result)
-    for t, line in _story(shown, level):
+    for t, line in _story(shown, level, distance):
         yield t, _with_name(line, name, width)
 
 
@@ -338,7 +369,8 @@ def summary(run: Run) -> list[Line]:
           f"velocity {final['velocity']}, LEDs ", "")] + lamps(final["outputs"]),
         [(f"  {plural(len(rec.reports) + rec.dropped['reports'], 'report')}, "
           f"{plural(len(rec.outputs) + rec.dropped['outputs'], 'LED change')}, ", ""),
-         (plural(len(rec.hazards), "hazard"), "bold red" if rec.hazards else "")],
+         (plural(len(rec.hazards), "hazard"), "bold red" if rec.hazards else ""),
+         (f", {len(rec.accepted)} accepted" if rec.accepted else "", "")],
     ]
 
 
@@ -369,18 +401,18 @@ def _summaries(result: Result) -> list[Line]:
 def _traces(result: Result) -> list[Line]:
     """Each controller's trace (under its name in a rig of several)."""
     if not result.rig.several:
-        return trace(result.only.record)
+        return trace(result.only.record, unit(result.only.machine.model))
     lines: list[Line] = []
     for name, run in result.runs.items():
-        lines += [[(f"{name}:", "bold")]] + trace(run.record)
+        lines += [[(f"{name}:", "bold")]] + trace(run.record, unit(run.machine.model))
     return lines
 
 
-def trace(record: Recorder) -> list[Line]:
+def trace(record: Recorder, unit: str = "counts") -> list[Line]:
     """Executed instructions, with the fast-forward jumps between them."""
     skips = [e for e in record.timeline if isinstance(e, ev.FastForwarded)]
     merged = sorted(record.trace + skips, key=lambda e: e.t)  # stable: skips after their RP
-    lines = [at(e.t) + [(e.text, "")] if isinstance(e, ev.Executed) else event_line(e)
+    lines = [at(e.t) + [(e.text, "")] if isinstance(e, ev.Executed) else event_line(e, unit)
              for e in merged]
     if record.dropped["trace"]:
         lines.append([(f"... {record.dropped['trace']:,} more instructions", "dim")])
@@ -453,6 +485,9 @@ def run_json(run: Run) -> dict:
                      **_source(h.where)} for h in rec.hazards],
         "events": [_event_json(e) for e in rec.events],
     }
+    if rec.accepted:  # hazards the user accepts (--allow-hazard, expect[...]): not counted
+        out["accepted_hazards"] = [{"t_ms": ms(h.t), "rule": h.rule, "message": h.message,
+                                    **_source(h.where)} for h in rec.accepted]
     if rec.trace:  # --trace: the executed instructions, capped like the lists above
         out["trace"] = [{"t_ms": ms(e.t), "macro": e.where.slot, "line": e.where.line,
                          "instruction": e.text, "name": e.where.label}
@@ -503,11 +538,15 @@ def _ended_json(e: ev.MoveEnded) -> dict:
 _EVENT_JSON = {
     ev.InputChanged: lambda e: {"t_ms": ms(e.t), "kind": "press" if e.on else "release",
                                 "input": e.input},
+    ev.JoystickMoved: lambda e: {"t_ms": ms(e.t), "kind": "joystick", "deflection": e.deflection,
+                                 "velocity": round(e.velocity, 3) + 0.0,  # never -0.0
+                                 "jn": e.maximum, "table": e.table},
     ev.OutputsChanged: lambda e: {"t_ms": ms(e.t), "kind": "output", "pattern": e.pattern},
     ev.Reported: lambda e: {"t_ms": ms(e.t), "kind": "report", **_source(e.where),
                             "text": e.text},
     ev.HazardFound: lambda e: {"t_ms": ms(e.t), "kind": "hazard", **_source(e.where),
-                               "rule": e.rule, "message": e.message},
+                               "rule": e.rule, "message": e.message,
+                               **({"accepted": True} if e.accepted else {})},
     ev.MoveStarted: _move_json,
     ev.MoveEnded: _ended_json,
     ev.HomeDefined: lambda e: {"t_ms": ms(e.t), "kind": "home", **_source(e.where),

@@ -90,13 +90,14 @@ class Trace:
     cut_at: int | None = None  # where recording stopped at CAP
     ended: int | None = None  # when the program ended (back in direct mode), if it stayed so
     idle_from: int | None = None  # from here to the end: program ended, stage at rest, no input
+    unit: str = "counts"  # what positions count in (commands.unit: steps on a C-663)
 
 
 class PlotObserver:
     """An event listener that keeps a Trace (the machine's listeners); call `close`."""
 
-    def __init__(self):
-        self.trace = Trace()
+    def __init__(self, unit: str = "counts"):
+        self.trace = Trace(unit=unit)
         self.segments: tuple = ()
         self.planned = None  # what a kept profile was planned from (MoveStarted.plan)
         self.sampled_to = 0.0
@@ -147,7 +148,7 @@ class PlotObserver:
                 self.segments = ()
                 self.trace.position.append((t, float(position)))
                 self.trace.target.append((t, position))
-            case ev.HazardFound(_, rule):
+            case ev.HazardFound(_, rule, _, _, False):  # an accepted one is no warning
                 self.trace.hazards.append((t, rule))
             case ev.FastForwarded(_, t_to, passes, _, loop, shape):
                 self.trace.skips.append((t, t_to, passes, loop.label))
@@ -334,7 +335,11 @@ class TimeAxis:
         from matplotlib.ticker import MaxNLocator
 
         total, pieces = self.drawn[-1] or 1.0, self.pieces()
-        wanted = [(d0, r0) for r0, r1, d0, d1 in pieces]  # the run's start (0 s) first
+        # the run's start (0 s) first, then its end (--until: '60 s', never the start of the
+        # last stepped millisecond), then where each piece after a band starts
+        real = self.real[-1] - self.real[0]
+        wanted = [(self.drawn[0], self.real[0]), (self.drawn[-1], self.real[-1])]
+        wanted += [(d0, _round(r0, real)) for r0, r1, d0, d1 in pieces[1:]]
         for r0, r1, d0, d1 in pieces:
             if d1 - d0 < total * TICK_ROOM:  # its start is all the ticks it has room for
                 continue
@@ -356,6 +361,17 @@ class TimeAxis:
         import numpy as np
 
         return float(np.interp(seconds, self._xp, self._fp))
+
+
+def _round(seconds: float, total: float) -> float:
+    """A band's end as its tick says it: to a thousandth of the whole run (a 60 s run's
+    piece starts at '59.984 s', not '59.98376 s'); the tick stands where it truly is."""
+    import math
+
+    if total <= 0:
+        return seconds
+    places = max(0, 3 - math.floor(math.log10(total)))
+    return round(seconds, places)
 
 
 def _merged(skips: list, actions: list) -> list:
@@ -454,7 +470,7 @@ def position(ax, trace: Trace, axis: TimeAxis) -> None:
                     fontsize=7, color="crimson", rotation=90, va="top", ha="right")
     if trace.cut_at is not None:
         _cut(ax, float(axis(trace.cut_at)), axis.drawn[-1])
-    ax.set_ylabel("position")
+    ax.set_ylabel(f"position ({trace.unit})")
     ax.yaxis.get_major_locator().set_params(integer=True)
     ax.ticklabel_format(axis="y", style="plain", useOffset=False)
     ax.grid(alpha=0.3)
@@ -665,7 +681,9 @@ def _band_labels(ax, axis: TimeAxis, bands: list) -> None:
 
 def watches(rig) -> dict[str, PlotObserver]:
     """One plot listener per controller of the rig, to hear its machine during the run."""
-    return {c.name: PlotObserver() for c in rig.controllers}
+    from mercmac.commands import unit
+
+    return {c.name: PlotObserver(unit(c.model)) for c in rig.controllers}
 
 
 def write_run(path: str, rig, watched: dict[str, PlotObserver], end_us: int,
@@ -714,6 +732,7 @@ def data(trace: Trace) -> dict:
     ms, shown, axis = 1e-3, _y_range(trace), _time_axis(trace)
     return {
         "lanes": list(LANES),
+        "unit": trace.unit,  # of the positions (commands.unit)
         "end_ms": trace.end * ms,
         "position": [[round(t * ms, 3), round(x, 1)] for t, x in trace.position],
         "target": [[t * ms, x] for t, x in trace.target],

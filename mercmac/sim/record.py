@@ -159,6 +159,7 @@ class Recorder:
         self.reports: list[ev.Reported] = []
         self.outputs: list[ev.OutputsChanged] = []
         self.hazards: list[ev.HazardFound] = []
+        self.accepted: list[ev.HazardFound] = []  # the hazards the user accepts (shown, not counted)
         self.timeline: list = []
         self.trace: list[ev.Executed] = []
         self.events: list = []  # every event but Executed, unfolded, for the JSON `events`
@@ -187,7 +188,8 @@ class Recorder:
             self._keep(self.trace, event, "trace")
             return
         self._keep(self.events, event, "events")
-        if kind is not ev.FastForwarded:
+        # a joystick moved from outside is no effect of a pass: a skip's copies never hold it
+        if kind is not ev.FastForwarded and kind is not ev.JoystickMoved:
             self._recent.append(event)
         if isinstance(event, (ev.MacroEntered, ev.MacroLeft)):
             self._flow(event)
@@ -197,7 +199,7 @@ class Recorder:
         elif isinstance(event, ev.OutputsChanged):
             self._keep(self.outputs, event, "outputs")
         elif isinstance(event, ev.HazardFound):
-            self.hazards.append(event)
+            (self.accepted if event.accepted else self.hazards).append(event)
         elif isinstance(event, ev.ProgramEnded):
             self.ended_at = event.t
         elif isinstance(event, ev.FastForwarded):

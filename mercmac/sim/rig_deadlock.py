@@ -1,4 +1,4 @@
-"""A rig dead-locked (MH008, vm/hazards.py; docs/rigs.md, "Dead-lock"): nothing is due any
+"""A rig dead-locked (MH008, mercmac/hazards.py; docs/rigs.md, "Dead-lock"): nothing is due any
 more (no timer, move, scripted button or joystick change), so no output and no wire will
 change, and every controller has ended or waits for good, one of them on a line.
 
@@ -18,7 +18,7 @@ from mercmac.vm.machine import Machine, Wait
 if TYPE_CHECKING:
     from mercmac.sim.simulate import Simulation
 
-RULE = "rig-deadlock"  # vm/hazards.py MH008
+RULE = "rig-deadlock"  # mercmac/hazards.py MH008
 
 
 def check(sim: Simulation) -> bool:
@@ -34,7 +34,8 @@ def check(sim: Simulation) -> bool:
     for name, m in waiting.items():
         message = m.hazards.add(RULE, (name,), waits=waits)
         if message is not None:
-            m.tell(ev.HazardFound(t, RULE, message, m.last_command()))
+            where = m.last_command()
+            m.tell(ev.HazardFound(t, RULE, message, where, m.accepts(RULE, where)))
     return True
 
 

@@ -194,9 +194,10 @@ def figure(rt: RigTrace, title: str = ""):
     """Lanes on one time axis on the left; the path picture on the right (2-3 axes)."""
     plt = plot.styled()
     names = [c.name for c in rt.rig.controllers]
-    fig = plt.figure(figsize=(16 if rt.axes else 11, max(6.5, 2.4 * len(names) + 1.5)),
-                     layout="constrained")
-    lanes_fig, path_fig = fig.subfigures(1, 2, width_ratios=[2, 1]) if rt.axes else (fig, None)
+    height = max(6.5, 2.4 * len(names) + 1.5)
+    side = _side(rt, height) if rt.axes else 0.0
+    fig = plt.figure(figsize=(11 + side, height), layout="constrained")
+    lanes_fig, path_fig = fig.subfigures(1, 2, width_ratios=[11, side]) if rt.axes else (fig, None)
     _lanes(lanes_fig, rt, names)
     if path_fig is not None:
         _paths(path_fig, rt)
@@ -214,7 +215,7 @@ def _lanes(fig, rt: RigTrace, names: list[str]) -> None:
     axes = fig.subplots(len(ratios), 1, sharex=True, gridspec_kw={"height_ratios": ratios})
     for i, name in enumerate(names):
         plot.position(axes[2 * i], rt.traces[name], axis)
-        axes[2 * i].set_ylabel(f"{name}: position (counts)")
+        axes[2 * i].set_ylabel(f"{name}: position ({rt.traces[name].unit})")
         if i:  # the legend once, above the first lane
             axes[2 * i].get_legend().remove()
         plot.macros(axes[2 * i + 1], rt.traces[name].macros, axis)
@@ -231,16 +232,34 @@ def _paths(fig, rt: RigTrace) -> None:
     views = [(1, 2)] + ([(1, 3)] if len(rt.axes) == 3 else [])
     axes = fig.subplots(len(views), 1, squeeze=False)[:, 0]
     for ax, (i, j) in zip(axes, views):
-        _path(ax, points[:, i], points[:, j], (rt.axes[i - 1], rt.axes[j - 1]))
+        named = (rt.axes[i - 1], rt.axes[j - 1])
+        _path(ax, points[:, i], points[:, j], named,
+              tuple(rt.traces[n].unit for n in named))
 
 
-def _path(ax, x, y, names: tuple[str, str]) -> None:
+def _side(rt: RigTrace, height: float) -> float:
+    """Inches for the path picture beside the lanes: as wide as its views, stacked in the
+    figure's height, need at one scale (a 20,000 by 12,000 raster is wider than tall), so
+    that it fills its column instead of floating small in it; 4-9 in."""
+    import numpy as np
+
+    points = path(rt)
+    views = 1 + (len(rt.axes) == 3)
+    spans = [float(np.nanmax(points[:, k]) - np.nanmin(points[:, k])) if len(points) else 0.0
+             for k in range(1, len(rt.axes) + 1)]
+    tall = max(max(spans[1:]), 1.0)
+    ratio = max(spans[0], 1.0) / tall
+    ratio = ratio if 0.1 <= ratio <= 10 else 1.0  # each axis its own scale (_frame)
+    return min(max((height / views - 1.2) * ratio + 1.2, 4.0), 9.0)
+
+
+def _path(ax, x, y, names: tuple[str, str], units: tuple[str, str]) -> None:
     ax.plot(x, y, color="tab:blue", lw=1.3, label="path")
     _jumps(ax, x, y)
     _ends(ax, x, y)
     _arrows(ax, x, y)
-    ax.set_xlabel(f"{names[0]}: position (counts)")
-    ax.set_ylabel(f"{names[1]}: position (counts)")
+    ax.set_xlabel(f"{names[0]}: position ({units[0]})")
+    ax.set_ylabel(f"{names[1]}: position ({units[1]})")
     ax.ticklabel_format(style="plain", useOffset=False)
     ax.grid(alpha=0.3)
     ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1), ncols=5, fontsize=8, frameon=False,

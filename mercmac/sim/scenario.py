@@ -1,6 +1,7 @@
 """Scenarios: timed button steps and expectations kept in TOML (`--scenario`).
 
     until = "10s"
+    allow_hazards = ["soft-limit-clamp"]  # hazards the program means (shown, not counted)
     [[step]]                     # inputs change at a time
     at = "0ms"
     press = [3]                  # and/or release = [3]
@@ -28,7 +29,7 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from mercmac.errors import MercmacError
-from mercmac.suggest import suggest
+from mercmac.suggest import did_you_mean
 from mercmac.timespec import TimeSpecError, parse_duration
 from mercmac.vm.machine import Machine
 
@@ -74,6 +75,7 @@ class Scenario:
     until_ms: int | None
     steps: list[Step]
     expects: list[Expect]
+    accepted: frozenset[str] = frozenset()  # hazard rules the scenario accepts (mercmac/hazards.py)
 
 
 def load(path: str) -> Scenario:
@@ -102,11 +104,26 @@ def parse(path: str, data: dict) -> Scenario:
 
 
 def _parse(path: str, data: dict) -> Scenario:
-    _refuse_unknown("", data, ("until", "step", "expect"), "use until, [[step]], [[expect]]")
+    _refuse_unknown("", data, ("until", "allow_hazards", "step", "expect"),
+                    "use until, allow_hazards, [[step]], [[expect]]")
     until = _duration("until", data["until"]) if "until" in data else None
     steps = [_step(i, s) for i, s in enumerate(_tables("step", data), 1)]
     expects = [_expect(i, e) for i, e in enumerate(_tables("expect", data), 1)]
-    return Scenario(path, until, sorted(steps, key=lambda s: s.at_ms), expects)
+    return Scenario(path, until, sorted(steps, key=lambda s: s.at_ms), expects,
+                    _allowed(data.get("allow_hazards", [])))
+
+
+def _allowed(value) -> frozenset[str]:
+    """allow_hazards: a list of hazard rules, codes or names (mercmac/hazards.py)."""
+    from mercmac.hazards import accepted_rules
+
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise ScenarioError(f"allow_hazards = {_show(value)}: write a list of hazard rules, "
+                            'e.g. allow_hazards = ["soft-limit-clamp"]')
+    try:
+        return accepted_rules(value, "allow_hazards")
+    except ValueError as e:
+        raise ScenarioError(str(e)) from None
 
 
 def _tables(key: str, data: dict) -> list[dict]:
@@ -154,15 +171,15 @@ def _refuse_unknown(where: str, raw: dict, valid: tuple[str, ...], use: str) -> 
     if not unknown:
         return
     key = unknown[0]
-    near = _nearest(key, valid)
-    hint = f"did you mean {near!r}? " if near else ""
+    hint = did_you_mean(key, valid, _reach(key))
+    hint = f"{hint} " if hint else ""
     more = f" (and {len(unknown) - 1} more)" if len(unknown) > 1 else ""
     raise ScenarioError(f"{where}unknown key {_show(key)}{more}: {hint}{use}")
 
 
-def _nearest(word: str, known) -> str | None:
-    """The key or macro name `word` was probably meant to be (two edits for short words)."""
-    return suggest(word, known, max(2, len(word) // 3))
+def _reach(word: str) -> int:
+    """How far a key or macro name may be misspelled: two edits for short words (`untill`)."""
+    return max(2, len(word) // 3)
 
 
 def _step(i: int, raw: dict) -> Step:
@@ -259,8 +276,8 @@ def check_names(m: Machine, scenario: Scenario) -> None:
     for expect in scenario.expects:
         want = expect.checks.get("macro")
         if isinstance(want, str) and want != "none" and want not in names:
-            near = _nearest(want, names)
-            hint = f"; did you mean {near!r}?" if near else \
+            near = did_you_mean(want, names, _reach(want))
+            hint = f"; {near}" if near else \
                 f"; it has {', '.join(sorted(names)) or 'no named macros'}"
             raise ScenarioError(f"{scenario.name}: expect {expect.number}: macro = {_show(want)}: "
                                 f"the program has no macro of that name{hint}")

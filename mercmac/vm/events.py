@@ -69,6 +69,22 @@ class InputChanged:
 
 
 @dataclass(frozen=True, slots=True)
+class JoystickMoved:
+    """The joystick held at a new deflection from outside (-1 full negative .. 1 full
+    positive; 0 the middle). MS176E §3.6.1: it sets the axis's velocity, so the event says
+    the velocity that deflection commands (counts or steps a second, signed; 0 while the
+    joystick is off), JN's maximum (0: off, §6.4 JN), the response table it goes through
+    (§6.4 JT) and whether input 5 now reads ON."""
+
+    t: int
+    deflection: float
+    velocity: float
+    maximum: int
+    table: int
+    input_on: bool
+
+
+@dataclass(frozen=True, slots=True)
 class OutputsChanged:
     t: int
     pattern: int
@@ -83,10 +99,16 @@ class Reported:
 
 @dataclass(frozen=True, slots=True)
 class HazardFound:
+    """A hazard (mercmac/hazards.py); `accepted` when the user said the program means it: the
+    rule allowed for the run (`sim --allow-hazard`, a scenario's `allow_hazards`) or
+    expected on its line (`// mercmac: expect[soft-limit-clamp]`). An accepted hazard is
+    shown, never counted (docs/simulator.md, "Hazards")."""
+
     t: int
     rule: str
     message: str
     where: Where | None
+    accepted: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -158,10 +158,14 @@ class Machine:
     wake: int = unkeyed("the clock: Visit.wake, from which the period of a pass comes")
     hazards: HazardLog = unkeyed("each is reported once: one in a pass makes its shape "
                                  "unrepeatable")
+    expected: Mapping[int, frozenset[str]] = unkeyed("the hazards the loaded program accepts, "
+                                                     "by source line: fixed with the program")
     active: int = unkeyed("a time: the last instant it did anything (a command or a hardware "
                           "event), when a rig that waits for good went still (sim/rig_deadlock.py)")
     table_done: float = unkeyed("a time: inf unless a JT table is being made, and then it "
                                 "bounds a skip as a hardware event (_next_hardware)")
+    restarted: bool = unkeyed("for the serial front end (take_restart), never read here; only "
+                              "power-on and RT set it, and neither can run in a macro")
 
     def __init__(self, program: Program | None = None, *, model: str | None = None,
                  cycle_ms: float = 1.0, options: Options | None = None,
@@ -181,8 +185,10 @@ class Machine:
         self.optimiser = Optimiser(self, FastForward(fast_forward))
         self.chunks, self._lines = {}, None
         self.hazards = HazardLog()
+        self.expected = {}
         self.active = 0
         self.deflection = None  # hardware: a reset leaves the joystick where it is
+        self.restarted = False
         self._reset_state()
         if program is not None:
             self.load(program)
@@ -198,6 +204,7 @@ class Machine:
     def load(self, program: Program) -> None:
         """Replace the stored macros; the machine state stays."""
         self.chunks = assemble(program, self.model)
+        self.expected = program.expected
         self._code_changed()
 
     def define(self, slot: int, ops: Iterable[Op], name: str = "") -> None:
@@ -207,6 +214,7 @@ class Machine:
 
     def power_on(self) -> None:
         """Power-on or RT: defaults per model, position 0; macro 0 starts if stored (§3.8.5)."""
+        self.restarted = True  # first: the front end deselects even if what follows fails
         self._reset_state()
         self.outputs.set_bits, self.outputs.pulse_until = 0, -INF
         self.axis.reset()
@@ -306,6 +314,12 @@ class Machine:
         """Record the error code that TS reports (§6.4 TS), as the serial front end does."""
         self.error = code
 
+    def take_restart(self) -> bool:
+        """Whether power-on or RT restarted the machine since the last call, once: the serial
+        front end then deselects the controller (MS176E §3.1, "After power-on or reset")."""
+        restarted, self.restarted = self.restarted, False
+        return restarted
+
     def take_self_select(self) -> int | None:
         """The address an SCn in macro 0 selected since the last call (§3.1.2), once."""
         return self.params.pop(Mnemonic.SC, None)
@@ -396,6 +410,10 @@ class Machine:
         joystick ON above mid-scale (lines.py)."""
         self.deflection = max(-1.0, min(1.0, float(deflection)))
         on = self.deflection > 0
+        # what the deflection commands, said first: the input change it makes follows
+        self._emit(ev.JoystickMoved(self.clock.now, self.deflection,
+                                    self.axis.joystick * self._joystick_response(),
+                                    self.axis.joystick, self._response_table(), on))
         if self.inputs.set(5, on):
             self._input_changed(5, on)  # which drives the axis when the joystick is on
         elif self.axis.joystick:
@@ -606,7 +624,8 @@ class Machine:
         self.optimiser.move_requested(target)
         if clamped != target:
             side = "upper" if clamped < target else "lower"
-            self._hazard("soft-limit-clamp", target=target, side=side, clamped=clamped)
+            self._hazard("soft-limit-clamp", each=(target, clamped), target=target, side=side,
+                         clamped=clamped)
         self._motion(ev.Motion.MOVE, lambda t: self.axis.move(t, clamped))
 
     def _refuse(self, rule: str, code: int, variant: str = "") -> None:
@@ -669,9 +688,12 @@ class Machine:
         response table (§6.4 JT: 0 linear, 1 cubic, 2 and 3 the same inverted); without
         set_joystick, input 5 ON is full positive deflection."""
         d = self.deflection if self.deflection is not None else float(self.inputs.state[5])
-        table = self.params.get(Mnemonic.JT, 1)  # §6.4 JT: cubic is the factory default
+        table = self._response_table()
         shaped = d ** 3 if table in (1, 3) else d
         return -shaped if table in (2, 3) else shaped
+
+    def _response_table(self) -> int:
+        return self.params.get(Mnemonic.JT, 1)  # §6.4 JT: cubic is the factory default
 
     # ---------------------------------------------------------------- I/O
     def _set_outputs(self, bits: int) -> None:
@@ -885,13 +907,24 @@ class Machine:
         return ev.Where(chunk.label, chunk.slot, ip, span)
 
     def _hazard(self, rule: str, variant: str = "", /, *,
-                where: ev.Where | None | Here = HERE, **values) -> None:
-        """Report `rule` in the words of its `variant` message (vm/hazards.py), once per place."""
+                where: ev.Where | None | Here = HERE, each: tuple = (), **values) -> None:
+        """Report `rule` in the words of its `variant` message (mercmac/hazards.py), once per place
+        (and per `each`: what makes one occurrence another), accepted when the run or the
+        program's line accepts it."""
         where = self._where(self.ip - 1) if where is HERE else where
-        place = (where.slot, where.ip) if where else None
+        place = (where.slot, where.ip, *each) if where else None
         message = self.hazards.add(rule, place, variant, **values)
         if message is not None:
-            self._emit(ev.HazardFound(self.clock.now, rule, message, where))
+            self._emit(ev.HazardFound(self.clock.now, rule, message, where,
+                                      self.accepts(rule, where)))
+
+    def accepts(self, rule: str, where: ev.Where | None) -> bool:
+        """Whether the user accepts hazard `rule` here: for the whole run (Options.accepted),
+        or on the source line of the command (Program.expected)."""
+        if rule in self.options.accepted:
+            return True
+        line = where.line if where is not None else None
+        return line is not None and rule in self.expected.get(line, ())
 
     def _emit(self, event: object) -> None:
         self.optimiser.emitted(event)

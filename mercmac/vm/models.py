@@ -46,6 +46,7 @@ class Options:
     hard_limits: tuple[int, int] | None = None  # (negative, positive) limit switch positions
     address: int = 0  # DIP switches 1-4, what TB reports (§6.4 TB)
     firmware: str = "2.30"  # the version VE reports (§6.4 VE example: "Ver. 2.30")
+    accepted: frozenset[str] = frozenset()  # hazard rules the user accepts for the run
 
 
 def model_name(name: str | None) -> str:

@@ -11,7 +11,7 @@ HEADINGS = {
     "checks.md": ["How check reads a file", "Rules", "Turning rules off", "Fixes", "Check in CI"],
     "simulator.md": ["Time", "Calls and the return point", "Repeat counters", "Conditions",
                      "Motion", "Outputs and reports", "Power-on", "Fast-forward",
-                     "What sim writes", "Scenarios and the live box"],
+                     "What sim writes", "Hazards", "Scenarios and the live box"],
     "uploader.md": ["The serial link", "Reading macros back", "A flash, step by step",
                     "Backups and history", "Signals and lost ports", "The emulator"],
     "rigs.md": ["The rig file", "A program is a rig of one", "Checking a rig", "Wires",

@@ -79,12 +79,12 @@ def _axes(fig) -> dict[str, object]:
 def test_one_position_lane_per_controller_on_one_time_axis(raster):
     fig = _figure(raster[1])
     axes = _axes(fig)
-    assert {"x: position (counts)", "y: position (counts)", "x: macro", "y: macro",
+    assert {"x: position (steps)", "y: position (steps)", "x: macro", "y: macro",
             "wires"} <= set(axes)
-    lanes = [axes[k] for k in ("x: position (counts)", "y: position (counts)", "wires")]
+    lanes = [axes[k] for k in ("x: position (steps)", "y: position (steps)", "wires")]
     assert len({ax.get_xlim() for ax in lanes}) == 1  # aligned in time
     for name in ("x", "y"):  # the lane draws the controller's own positions
-        line = axes[f"{name}: position (counts)"].get_lines()[0]
+        line = axes[f"{name}: position (steps)"].get_lines()[0]
         assert round(line.get_ydata()[-1]) == raster[0].runs[name].machine.position()
 
 
@@ -115,11 +115,11 @@ def test_the_path_is_the_simulated_positions_with_start_and_end(raster):
     assert np.array_equal(drawn["path"].get_ydata(), points[:, 2], equal_nan=True)
     assert (drawn["start"].get_xdata()[0], drawn["start"].get_ydata()[0]) == (0, 0)
     assert [round(drawn["end"].get_xdata()[0]), round(drawn["end"].get_ydata()[0])] == final
-    assert ax.get_xlabel() == "x: position (counts)"
+    assert ax.get_xlabel() == "x: position (steps)"
 
 
 def _path_axes(fig) -> list:
-    return [ax for ax in fig.subfigs[1].axes if ax.get_xlabel().endswith("(counts)")]
+    return [ax for ax in fig.subfigs[1].axes if ax.get_xlabel().endswith("(steps)")]
 
 
 def test_the_raster_reads_as_rows_swept_and_stepped(raster):
@@ -179,7 +179,7 @@ def test_a_deadlock_is_marked_on_both_lanes():
     rt = rig_plot.trace_of(rig, watches, 1_000_000)
     axes = _axes(_figure(rt))
     for name in ("x", "y"):
-        texts = [t.get_text() for t in axes[f"{name}: position (counts)"].texts]
+        texts = [t.get_text() for t in axes[f"{name}: position (steps)"].texts]
         assert "rig-deadlock" in texts
 
 
@@ -188,8 +188,8 @@ def test_three_axes_give_two_projections():
     run, rt = _run(rig, until_ms=4000)
     fig = _figure(rt)
     labels = [(ax.get_xlabel(), ax.get_ylabel()) for ax in _path_axes(fig)]
-    assert labels == [("x: position (counts)", "y: position (counts)"),
-                      ("x: position (counts)", "z: position (counts)")]
+    assert labels == [("x: position (steps)", "y: position (steps)"),
+                      ("x: position (steps)", "z: position (steps)")]
     assert rig_plot.path(rt)[-1, 3] == run.runs["z"].machine.position() == 500
 
 
@@ -225,7 +225,7 @@ def test_the_html_page_holds_the_lanes_and_the_path(raster, tmp_path):
     rig_plot.write(str(out), rt, "mercmac sim raster.rig.toml")
     page = out.read_text()
     texts = svg_texts(inline_svg(page))
-    assert {"x: position (counts)", "y: position (counts)", "wires", "start", "end"} <= set(texts)
+    assert {"x: position (steps)", "y: position (steps)", "wires", "start", "end"} <= set(texts)
     data = page_data(page)
     assert data["controllers"] == ["x", "y"] and set(data["lanes"]) == {"x", "y"}
     assert data["path"]["axes"] == ["x", "y"]
