@@ -95,9 +95,6 @@ def _run(req: Request) -> bool:
         if rig_file.rig is None:  # the rig file itself has errors: shown as `check` does
             opened(rig_file.accepted)
             return False
-    elif req.joystick:
-        raise UsageError("--joystick is for a rig file (*.rig.toml), whose [joystick] table "
-                         "says which controller each branch drives")
     script = _script(req, rig_file.rig if rig_file else None)
     if req.vcd:  # a path that cannot be written is refused before any work (exit 2)
         writable_target(req.vcd)
@@ -154,7 +151,8 @@ def _script(req: Request, rig: Rig | None) -> Script:
     """The presses, the joystick and the inputs held at power-on, as the options give them;
     on a rig (`rig`), by controller and only what a person can press there."""
     presses = _presses(req.buttons) if rig is None else buttons(rig, req.buttons)
-    holds = [] if rig is None else joystick(rig, req.joystick)
+    # a lone program is a rig of one with the joystick on it (branch X; docs/rigs.md)
+    holds = joystick(rig or Rig.of_program(req.file, req.target), req.joystick)
     if req.scenario and presses:  # two button scripts for one run: which one wins is a guess
         where = ("; add the presses there (at = \"1s\", press = [1], then release = [1])"
                  if rig is None else " (controller = \"x\" says whose)")
@@ -416,6 +414,8 @@ def _deflection(rig: Rig, item: str):
         raise UsageError(f"--joystick '{item}': write NAME=D@T1-T2 or NAME=D@T1, "
                          "e.g. x=+0.5@1s-3s (D from -1 to 1)")
     who, value, start, end = m.groups()
+    if rig.lone and who not in rig.joystick and who != rig.controllers[0].name:
+        _lone_branch(item)
     name = rig.joystick.get(who, who)  # a branch names its controller
     _branch_known(rig, who, item)
     _known(rig, name, "--joystick", item)
@@ -445,8 +445,16 @@ def _branch_known(rig: Rig, who: str, item: str) -> None:
     why = (f"the rig's [joystick] table has no branch {who} (only {has})" if has else
            f"{who} is a joystick branch, and the rig has no [joystick] table to say which "
            "controller it goes to")
+    if rig.lone:
+        _lone_branch(item)
     raise UsageError(f"--joystick '{item}': {why}",
                      hint=f"add {who} = \"NAME\" under [joystick] in the rig file")
+
+
+def _lone_branch(item: str) -> None:
+    """UsageError: a program alone is a rig of one, its joystick on branch X (docs/rigs.md)."""
+    raise UsageError(f"--joystick '{item}': a program alone has one joystick, on branch X",
+                     hint="write X=D@T1-T2, e.g. --joystick \"X=+0.5@1s-3s\"")
 
 
 def _until(text: str | None, fallback: int | None) -> int:

@@ -126,6 +126,8 @@ def _move(t: int, kind: ev.Motion, target: int, arrival: float, segments: tuple)
     # where the stage is at t: a profile kept from before (MoveStarted.kept) began earlier
     start = (f" from {round(next((s for s in segments if t < s.t1), segments[-1]).x(t))}"
              if segments else "")
+    if kind == ev.Motion.JOYSTICK:  # it runs while deflected: the end of its range, not a goal
+        return f"joystick runs toward {target}{start} (its range's end) while deflected"
     when = "never arrives" if arrival == math.inf else \
         f"arrives {clock(arrival)}, in {format_span(arrival - t)}"
     return f"{kind} to {target}{start} ({when})"

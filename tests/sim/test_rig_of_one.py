@@ -62,6 +62,20 @@ def test_the_readme_run_shows_alike_for_the_program_and_its_rig_of_one(tmp_path)
     assert "0.445 s  fast-forward 14 identical passes of steps (MC04)" in one["text"][1]
 
 
+def test_the_joystick_of_a_program_alone_is_its_rig_of_ones(tmp_path):
+    """A program is a rig of one with the joystick on it (branch X): `--joystick` was
+    refused for it ("is for a rig file") though its rig of one took it."""
+    source = tmp_path / "js.mcm"
+    source.write_text("target C-863\nautostart { JN 8000 }\n", encoding="utf-8")
+    program, rig = rig_of_one(tmp_path / "r", source)
+    args = ["--joystick", "X=+0.5@1s-3s", "--until", "4s"]
+    alone, one = outputs(program, args, tmp_path), outputs(rig, args, tmp_path)
+    assert alone == one and alone["text"][0] == 0
+    assert "joystick at +0.50 (input 5 ON): commands +1,000 counts/s" in alone["text"][1]
+    refused = sim(program, "--joystick", "Y=-1@1s")
+    assert refused.exit_code == 2 and "a program alone has one joystick, on branch X" in refused.output
+
+
 def test_the_plot_draws_the_same_lanes(tmp_path):
     pytest.importorskip("matplotlib")
     program, rig = rig_of_one(tmp_path / "r", FOUR_MODES)

@@ -147,11 +147,12 @@ def test_a_branch_the_rig_does_not_connect_is_said_to_be_a_branch(tmp_path, toml
     assert words in result.stderr and "Traceback" not in result.output
 
 
-def test_the_joystick_is_for_rigs(tmp_path):
+def test_a_program_alone_has_its_joystick_on_branch_x(tmp_path):
     single = tmp_path / "a.mcm"
-    single.write_text("autostart { JN 100 }\n", encoding="utf-8")
+    single.write_text("autostart { JN 1000 }\n", encoding="utf-8")
     result = sim(single, "--joystick", "x=1@0")
-    assert result.exit_code == 2 and "rig file" in result.output
+    assert result.exit_code == 2 and "a program alone has one joystick, on branch X" in result.output
+    assert sim(single, "--joystick", "X=1@0").exit_code == 0
 
 
 def test_the_vcd_has_a_scope_per_controller(tmp_path):
