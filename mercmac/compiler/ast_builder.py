@@ -29,6 +29,13 @@ def _number(tok: Lexeme) -> ast.Number | ast.Invalid:
 _read_number = functools.lru_cache(maxsize=4096)(mdtext.number)
 
 
+def _through(span: Span, last: Lexeme) -> Span:
+    """A one-line statement's span from its start to the end of its last token: the newline
+    that ends it, and the blank lines after it, are not the statement's (an editor would
+    underline the next line)."""
+    return Span(span.line, span.column, last.span.end_line, last.span.end_column)
+
+
 class _Nodes:
     """Each rule's node of its span and children (tokens as parse.Lexeme)."""
 
@@ -48,13 +55,14 @@ class _Nodes:
 
     def target(self, span, children):
         model = children[0].value.upper()
-        return ast.Target(model if "-" in model else f"{model[0]}-{model[1:]}", span)
+        return ast.Target(model if "-" in model else f"{model[0]}-{model[1:]}",
+                          _through(span, children[0]))
 
     def const(self, span, children):
         name, value = children
         number = _number(value)
         kept = number.value if isinstance(number, ast.Number) else number
-        return ast.Const(name.value, kept, span)
+        return ast.Const(name.value, kept, _through(span, value))
 
     def macro(self, span, children):
         name, *rest = children

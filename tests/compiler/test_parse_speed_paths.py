@@ -118,9 +118,53 @@ def outcome(text: str) -> str:
     node's type), the broken lines and the syntax errors."""
     report = Report("t.mcm")
     parsed = _parse_module(text, report)
-    tree = repr(parsed.tree).replace(", sign=''", "")  # a name without a sign, as it was
+    module = parsed.tree
+    if module is not None and hasattr(ast_builder, "parse_module"):  # (not at the golden's commit)
+        module = _as_before(module, text)
+    tree = repr(module).replace(", sign=''", "")  # a name without a sign, as it was
     found = [tree, sorted(parsed.broken), parsed.failed, _diagnostics(report)]
     return hashlib.sha256(json.dumps(found).encode()).hexdigest()[:16]  # 64 bits: enough
+
+
+# The reading before ended a `const` or `target` statement's span past its newline and the
+# blank lines after it (grammar.lark's _NL), so an editor underlined the next line; it ends
+# at its last token since. What lies between: blanks, a comment, then the newlines.
+_NL_AFTER = re.compile(r"[ \t\f]*(?://[^\n]*)?((?:\n[ \t]*)+)")
+_AT_END = re.compile(r"[ \t\f]*(?://[^\n]*)?\Z")
+
+
+def _recovered_one_liner(text: str) -> bool:
+    """A text with syntax errors that holds `const` or `target`: lark's recovery gave such a
+    statement's span the token after its error, which `_as_before` cannot tell again (the
+    in-process comparisons below still hold both readings to one result)."""
+    report = Report("t.mcm")
+    return _parse_module(text, report).failed and re.search(r"\b(const|target)\b", text) is not None
+
+
+def _as_before(module, text: str):
+    """MODULE with its const and target spans as the reading before made them."""
+    from mercmac.compiler import ast
+    from mercmac.source import Span, to_lf
+
+    lf = to_lf(text)
+    starts = [0] + [m.end() for m in re.finditer("\n", lf)]
+    items = []
+    for item in module.items:
+        if isinstance(item, (ast.Const, ast.Target)):
+            s = item.span
+            at = starts[s.end_line - 1] + s.end_column - 1
+            found = _NL_AFTER.match(lf, at)
+            if found is not None:
+                end = found.end()
+                line = lf.count("\n", 0, end) + 1
+                column = end - starts[line - 1] + 1
+                if end == len(lf):  # and the newline the reading adds at the end of the text
+                    line, column = line + 1, 1
+                item = item._replace(span=Span(s.line, s.column, line, column))
+            elif _AT_END.match(lf, at):  # the newline the reading adds at the end of the text
+                item = item._replace(span=Span(s.line, s.column, s.end_line + 1, 1))
+        items.append(item)
+    return module._replace(items=tuple(items))
 
 
 def golden_cases(examples: dict[str, str]) -> dict[str, str]:
@@ -146,7 +190,8 @@ def test_golden_outcomes_of_the_reading_before():
     cases = golden_cases(expected["examples"])
     assert set(expected["outcomes"]) == set(cases), "HOSTILE changed: regenerate (see the top)"
     differ = [(name, text[:300]) for name, text in sorted(cases.items())
-              if outcome(text) != expected["outcomes"][name] and not _SIGNED_NAME.search(text)]
+              if outcome(text) != expected["outcomes"][name] and not _SIGNED_NAME.search(text)
+              and not _recovered_one_liner(text)]
     assert not differ
 
 

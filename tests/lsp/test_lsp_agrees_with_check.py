@@ -233,3 +233,21 @@ async def test_a_settings_file_check_refuses_is_shown_once_and_the_file_still_ch
             content_changes=[t.TextDocumentContentChangeWholeDocument(text="[MC01] EM9\n" * version)]))
         await _wait(client)
     assert len(client.messages) == 1 and "is not a model" in client.messages[0].message
+
+
+# A statement that ends its line (`const`, `target`): its span used to take the newline and
+# the blank lines after it, so the editor underlined the next statement (and the server,
+# which reads a chunk with a newline added, one line more than `check` said).
+ONE_LINERS = "target C-999\nconst A = 1\nconst A = 2\n\n\nautostart { MR A }\n"
+
+
+@pytest.mark.asyncio
+async def test_a_one_line_statement_is_marked_on_its_own_line(client: LanguageClient, tmp_path):
+    path = tmp_path / "one.mcm"
+    path.write_text(ONE_LINERS, encoding="utf-8")
+    await _start(client, None, pull=False)  # first: the fixture's shutdown needs a session
+    published = (await _open_all(client, [path]))["one.mcm"]
+    expected = _check([path], [])["one.mcm"]
+    assert [(code, line, end_line, end) for code, line, _, end_line, end, _ in expected] == [
+        ("MM003", 0, 0, 12), ("MM018", 2, 2, 11)]
+    assert published == expected
