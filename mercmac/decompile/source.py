@@ -96,7 +96,8 @@ class _Writer:
 
     def _rest(self, rest: int | None, ops, i: int, caller: int, helper: int) -> bool:
         """Whether `rest` is the macro that both a hoisted block and its caller end in."""
-        return (rest is not None and i == len(ops) - 2 and ops[-1].arg == rest
+        return (rest is not None and i == len(ops) - 2 and ops[-1].mnemonic == Mnemonic.EM
+                and ops[-1].arg == rest  # (`MR3` after the call is no call of MC03)
                 and self.counts[rest] == 2 and rest not in (0, caller, helper)
                 and self.lines.get(rest) is not None and self.lines[rest].ops is not None
                 and self.levels[rest] != RAW)
