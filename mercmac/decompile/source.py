@@ -181,8 +181,9 @@ class _Writer:
                 body = self.seq(ops[i + len(run):], loop=False, hoisted=hoisted)
                 return out + [_when(run, body)]
             before = _em_to(ops[i - 1]) if i else None
-            if before in self.loops and before in self.folded and self.loops[before][2] == op.arg:
-                continue  # the rest after a folded loop is written after it
+            if (before in self.loops and before in self.folded and op.mnemonic == Mnemonic.EM
+                    and self.loops[before][2] == op.arg):
+                continue  # the rest after a folded loop is written after it (its EM)
             if op.mnemonic == Mnemonic.EM:
                 out += self.em(op.arg, last and not loop, hoisted)
             else:

@@ -102,6 +102,14 @@ def test_a_command_whose_argument_is_a_slot_is_no_call_of_it():
     round_trip({1: "MR0", 2: "MR0", 3: "MR0,MR0,MR0,EM3", 4: "XN1,MR0,EM3", 0: "EM4,MR3"})
 
 
+def test_a_loop_folds_back_before_a_command_without_argument():
+    """After a folded loop, a command whose argument is none, as the loop's `rest` is none,
+    was taken for the loop's rest and left out, so the fold was refused and the loop kept
+    as a macro of its own."""
+    source = round_trip({1: "MR1,WA5,RP2", 0: "MR5,EM1,TP"})
+    assert "repeat 3 { MR 1, WA 5 }" in source and "macro loop" not in source
+
+
 @settings(max_examples=budget(60), deadline=None, suppress_health_check=list(HealthCheck))
 @given(programs())
 def test_built_programs_round_trip(text):
