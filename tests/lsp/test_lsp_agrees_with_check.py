@@ -10,7 +10,6 @@ values as options. The server used to publish every finding, suppressed or not.
 """
 from __future__ import annotations
 
-import asyncio
 import json
 import subprocess
 import sys
@@ -18,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from helpers.lsp_client import next_notification
 from helpers.paths import EXAMPLE_FILES
 
 pytest_lsp = pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
@@ -106,8 +106,7 @@ WAIT_S = 30.0  # generous for a busy machine; a server that never answers fails 
 
 async def _wait(client: LanguageClient) -> None:
     """The next publishDiagnostics, or a failure after WAIT_S."""
-    await asyncio.wait_for(client.wait_for_notification(t.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS),
-                           WAIT_S)
+    await next_notification(client, t.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS, WAIT_S)
 
 
 def _published(diagnostics) -> list[tuple]:

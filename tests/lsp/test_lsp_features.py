@@ -13,11 +13,11 @@
 """
 from __future__ import annotations
 
-import asyncio
 
 import pytest
 
 from helpers.compiling import compile_text
+from helpers.lsp_client import next_notification
 
 pytest.importorskip("pytest_lsp", reason="the test extra installs pytest-lsp")
 from lsprotocol import types as t  # noqa: E402  (pytest-lsp brings it)
@@ -53,8 +53,7 @@ macro jog { call scan }
 async def _open(client: LanguageClient, text: str) -> None:
     client.text_document_did_open(t.DidOpenTextDocumentParams(
         text_document=t.TextDocumentItem(uri=URI, language_id="mcm", version=1, text=text)))
-    await asyncio.wait_for(client.wait_for_notification(t.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS),
-                           WAIT_S)
+    await next_notification(client, t.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS, WAIT_S)
 
 
 def _position(text: str, marked: str, nth: int = 0) -> t.Position:
