@@ -16,6 +16,9 @@ from mercmac.suggest import candidates, distance
 C663 = "C-663"
 C863 = "C-863"
 MODELS = (C663, C863)
+BOTH = frozenset(MODELS)
+ONLY_663 = frozenset({C663})
+ONLY_863 = frozenset({C863})
 
 
 def unit(model: str | None) -> str:
@@ -23,9 +26,6 @@ def unit(model: str | None) -> str:
     1/16 of a full step), the C-863 encoder counts; counts when the model is unknown. Every
     place that shows a distance says this one word: describe, the timeline, the plot."""
     return "steps" if model == C663 else "counts"
-BOTH = frozenset(MODELS)
-ONLY_663 = frozenset({C663})
-ONLY_863 = frozenset({C863})
 
 # MS176E §6.4 MA: -1,073,741,824 < n < 1,073,741,823; MR: the resulting target
 # must lie within +/-1,073,741,823.

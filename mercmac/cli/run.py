@@ -152,7 +152,8 @@ def _script(req: Request, rig: Rig | None) -> Script:
     on a rig (`rig`), by controller and only what a person can press there."""
     presses = _presses(req.buttons) if rig is None else buttons(rig, req.buttons)
     # a lone program is a rig of one with the joystick on it (branch X; docs/rigs.md)
-    holds = joystick(rig or Rig.of_program(req.file, req.target), req.joystick)
+    holds = joystick(rig or Rig.of_program(req.file, req.target), req.joystick) \
+        if req.joystick else []
     if req.scenario and presses:  # two button scripts for one run: which one wins is a guess
         where = ("; add the presses there (at = \"1s\", press = [1], then release = [1])"
                  if rig is None else " (controller = \"x\" says whose)")
