@@ -110,3 +110,8 @@ class Documents(Workspace):
                               language_id: str | None = None) -> Document:
         return Document(doc_uri, source=source, version=version, language_id=language_id,
                         sync_kind=self._sync_kind, position_codec=self.position_codec)
+
+    def unopened(self, uri: str, text: str) -> Document:
+        """A Document of a file the editor has not opened (a rig's program, as read), to
+        send positions in it in the session's units."""
+        return self._create_text_document(uri, source=text)

@@ -123,6 +123,20 @@ def _rig_file(path: str, text: str | None) -> RigFile | None:
         return None
 
 
+def programs_of(path: str, text: str) -> tuple[list[str], str | None]:
+    """The program files the rig at `path` (`text`: its editor text) names, as `fmt RIG`
+    formats them, or why they cannot be known."""
+    from mercmac.rig.open import RigUnreadable, open_rig
+
+    try:
+        rig_file = open_rig(path, text=text).rig_file
+    except RigUnreadable as e:
+        return [], e.message
+    if rig_file.rig is None:
+        return [], "the rig file has errors (its diagnostics say which)"
+    return [c.program for c in rig_file.rig.controllers], None
+
+
 def program_rig_diagnostics(owner: Owner, source: Source, choice: Choice) -> list[Diagnostic]:
     """What the rig rules of `check RIG` report in the program `source` (the editor's text
     of the owner's controller's program; the rig's other programs as saved)."""

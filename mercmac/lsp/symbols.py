@@ -12,11 +12,12 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
-from mercmac.commands import COMMANDS, Mnemonic, lookup
+from mercmac.commands import COMMANDS, Mnemonic
 from mercmac.compiler import ast
 from mercmac.compiler.checks import name_span
 from mercmac.compiler.parse import KEYWORDS  # noqa: F401  (completion and rename use them)
 from mercmac.compiler.program import Program, wait_pieces
+from mercmac.lsp import lowered
 from mercmac.mdtext import slot_name
 from mercmac.ops import Origin
 from mercmac.render.commands import KEYWORD_HELP  # noqa: F401  (hover and completion)
@@ -149,12 +150,12 @@ def macro_help(name: str, program: Program | None) -> str:
     lines = [f"**macro {name}**"]
     if program is None:
         return lines[0] + _UNLOWERED
-    mine = slots_of(name, program)
+    mine = lowered.of_macro(name, program)
     if not mine:
         return lines[0] + "\n\n(no slot: not defined)"
     lines += ["", f"slot{'s' if len(mine) > 1 else ''}: "
               + ", ".join(slot_name(m.slot) for m in mine), "", "```", *(m.md for m in mine), "```",
-              "", _called_by(mine[0].slot, program)]
+              "", lowered.count_lines(mine), "", _called_by(mine[0].slot, program)]
     return "\n".join(lines)
 
 
@@ -248,12 +249,6 @@ def partial_items(text: str) -> tuple:
     if parsed.tree is None:
         return ()
     return tuple(i for i in parsed.tree.items if getattr(i, "name", None) != BROKEN)
-
-
-def slots_of(name: str, program: Program) -> list:
-    """The lowered macros of a named macro: its own slot and the ones made from its blocks."""
-    return sorted((m for m in program.macros.values()
-                   if m.name == name or m.name.startswith(name + ".")), key=lambda m: m.slot)
 
 
 def const_help(name: str, items: tuple) -> str:

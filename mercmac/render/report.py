@@ -246,8 +246,11 @@ def to_sarif(diagnostics: Iterable[Diagnostic], limit: int = MAX_JSON) -> str:
 
 
 def _sarif_rule(r) -> dict:
+    from mercmac.render.rules_page import url
+
     return {"id": r.code, "name": r.name, "shortDescription": {"text": r.summary},
             "fullDescription": {"text": r.explanation}, "help": {"text": r.explanation},
+            "helpUri": url(r),
             "defaultConfiguration": {"level": _SARIF_LEVEL[r.severity]}}
 
 

@@ -40,6 +40,7 @@ Hardware:
     mercmac/upload/rig.py          a rig's backup paths; pulling a chain into a rig folder
 Editor:
     mercmac/lsp/rig.py             rig files and the programs a rig names, in the editor
+    mercmac/lsp/links.py           a rig file's `program` values and the files they name
 """
 
 SUFFIX = ".rig.toml"

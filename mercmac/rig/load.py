@@ -276,6 +276,13 @@ def _why_refused(folder: str, program: str) -> str | None:
     return None
 
 
+def program_path(rig_path: str, program: str) -> str | None:
+    """The file that the rig file at `rig_path` names by `program` (a controller's value),
+    as the reader takes it (_why_refused); None for a path the reader refuses."""
+    folder = os.path.dirname(os.path.abspath(rig_path))
+    return None if _why_refused(folder, program) is not None else os.path.join(folder, program)
+
+
 def _shown(text: str, most: int = 60) -> str:
     """`text`, cut to its first `most` characters (a 5,000-digit wire is said, not echoed)."""
     return text if len(text) <= most else text[:most] + "…"

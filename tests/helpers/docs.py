@@ -20,4 +20,5 @@ HEADINGS = {
                "Describe and decompile", "Names from outside", "Exit codes", "JSON output",
                "Limits"],
     "editors.md": ["The language server", "VS Code", "Neovim", "Emacs", "Pygments"],
+    "rules.md": ["Program rules (MM)", "Rig rules (MR)", "Runtime hazards (MH)"],
 }

@@ -172,7 +172,7 @@ async def test_document_symbols_list_macros_with_their_slots(client: LanguageCli
 
 @pytest.mark.asyncio
 async def test_formatting_goes_through_mercmac_fmt(client: LanguageClient):
-    from mercmac.lsp.server import formatter
+    from mercmac.lsp.edits import formatter
 
     format_text = formatter()
     if format_text is None:

@@ -11,6 +11,8 @@ values as options. The server used to publish every finding, suppressed or not.
 from __future__ import annotations
 
 import json
+import random
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -250,3 +252,66 @@ async def test_a_one_line_statement_is_marked_on_its_own_line(client: LanguageCl
     assert [(code, line, end_line, end) for code, line, _, end_line, end, _ in expected] == [
         ("MM003", 0, 0, 12), ("MM018", 2, 2, 11)]
     assert published == expected
+
+
+def _edit(rng: random.Random, lines: list[str]) -> tuple[t.Range, str]:
+    """One edit as an editor sends it (a range and its new text), of a kind that moves
+    statements across the re-checker's chunks: a line added (a `const`, a blank, a copy of
+    another), a line taken out, two lines joined, a word changed."""
+    n = len(lines)
+    at = rng.randrange(n)
+    kind = rng.choice(("const", "blank", "copy", "delete", "join", "word"))
+    start = t.Position(at, 0)
+    if kind == "const":
+        return t.Range(start, start), f"const {rng.choice('ABC')} = {rng.randrange(9)}\n"
+    if kind == "blank":
+        return t.Range(start, start), "\n" * rng.randint(1, 3)
+    if kind == "copy":
+        return t.Range(start, start), lines[rng.randrange(n)] + "\n"
+    if kind == "delete" and at + 1 < n:
+        return t.Range(start, t.Position(at + 1, 0)), ""
+    if kind == "join" and at + 1 < n:
+        return t.Range(t.Position(at, len(lines[at])), t.Position(at + 1, 0)), " "
+    words = [m for m in re.finditer(r"[A-Za-z]+", lines[at])]
+    if not words:
+        return t.Range(start, start), "// an edit\n"
+    word = rng.choice(words)
+    new = rng.choice(("MX", "WA", "target", "macro", word.group()[::-1]))
+    return t.Range(t.Position(at, word.start()), t.Position(at, word.end())), new
+
+
+def _apply(text: str, rng_: t.Range, new: str) -> str:
+    lines = text.split("\n")
+    start = sum(len(x) + 1 for x in lines[:rng_.start.line]) + rng_.start.character
+    end = sum(len(x) + 1 for x in lines[:rng_.end.line]) + rng_.end.character
+    return text[:start] + new + text[end:]
+
+
+# positions here count characters: the examples' are one UTF-16 unit each, as the LSP's are
+EDITED = [p for p in EXAMPLE_FILES if max(map(ord, p.read_text(encoding="utf-8"))) < 0x10000]
+
+
+@pytest.mark.slow
+@pytest.mark.asyncio
+@pytest.mark.parametrize("example", EDITED, ids=lambda p: p.name)
+async def test_after_random_edits_the_ranges_are_checks(client: LanguageClient, tmp_path,
+                                                        example: Path):
+    """Each example edited at random, an edit at a time as an editor sends them: after
+    each, the server's diagnostics (ranges included) are `check --format json`'s."""
+    rng = random.Random(f"{example.name}-30")
+    path = tmp_path / example.name
+    text = example.read_text(encoding="utf-8")
+    path.write_text(text, encoding="utf-8")
+    await _start(client, None, pull=False)
+    await _open_all(client, [path])
+    for version in range(2, 10):
+        change, new = _edit(rng, text.split("\n"))
+        text = _apply(text, change, new)
+        waiting = next_notification(client, t.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS, WAIT_S)
+        client.text_document_did_change(t.DidChangeTextDocumentParams(
+            text_document=t.VersionedTextDocumentIdentifier(uri=path.as_uri(), version=version),
+            content_changes=[t.TextDocumentContentChangePartial(range=change, text=new)]))
+        await waiting
+        path.write_text(text, encoding="utf-8")
+        assert _published(client.diagnostics[path.as_uri()]) == _check([path], [])[path.name], \
+            f"after edit {version - 1} ({change}, {new!r}):\n{text}"

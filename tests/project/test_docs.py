@@ -133,3 +133,21 @@ def test_readme_links_every_page():
     linked = {(README.parent / href.partition("#")[0]).resolve()
               for href in filter(_relative, _links(README))}
     assert [_name(p) for p in PAGES if p.resolve() not in linked] == []
+
+
+def test_the_rules_page_is_what_explain_says():
+    from mercmac.render.rules_page import markdown
+
+    assert (DOCS / "rules.md").read_text(encoding="utf-8") == markdown(), \
+        "regenerate it: python -m mercmac.render.rules_page > docs/rules.md"
+
+
+def test_each_rule_link_names_a_heading_of_the_page():
+    """An editor's diagnostic code and SARIF's helpUri link to the rule's heading."""
+    from mercmac.render.explain import ALL
+    from mercmac.render.rules_page import PAGE, url
+
+    anchors = _anchors(DOCS / "rules.md")
+    for rule in ALL:
+        page, _, anchor = url(rule).partition("#")
+        assert page == PAGE and anchor in anchors, rule.code
