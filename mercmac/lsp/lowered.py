@@ -62,7 +62,9 @@ def _budget(program: Program, first: str) -> Hint:
     used = sorted(program.macros.values(), key=_build_order)
     free = _runs([s for s in SLOTS if s not in program.macros])
     tooltip = "\n".join([f"- {m.written}" for m in used] + [f"- free: {free or 'none'}"])
-    return Hint(1, _line_end(first), f"{len(used)} of {len(SLOTS)} slots", tooltip)
+    # at the very end of the line: a first line is often a comment, and a label before it
+    # would stand at column 1
+    return Hint(1, len(first.rstrip()) + 1, f"{len(used)} of {len(SLOTS)} slots", tooltip)
 
 
 def _runs(slots: list[int]) -> str:
@@ -131,8 +133,9 @@ def _count(macro: Macro) -> str:
     return f"{len(macro.ops)} of {MAX_COMMANDS} commands"
 
 
-def lenses(items: tuple, program: Program | None) -> list[Lens]:
-    """A "build" lens on each macro, the autostart block and each raw block: its MD lines."""
+def lenses(items: tuple, program: Program | None, errors: int = 0) -> list[Lens]:
+    """A "build" lens on each macro, the autostart block and each raw block: its MD lines;
+    with `errors` in the file, `build` writes none, so the lens says so and copies nothing."""
     if program is None:
         return []
     out = []
@@ -145,7 +148,10 @@ def lenses(items: tuple, program: Program | None) -> list[Lens]:
             mine = of_macro(name, program)
         else:
             continue
-        if mine:
+        if mine and errors:
+            out.append(Lens(item.span.line, f"build: {_slots(mine)}, not built while the file "
+                                             f"has {errors} error{'s' * (errors > 1)}", name, ()))
+        elif mine:
             out.append(Lens(item.span.line, _title(mine), name, tuple(m.md for m in mine)))
     return out
 
@@ -153,8 +159,12 @@ def lenses(items: tuple, program: Program | None) -> list[Lens]:
 def _title(mine: list[Macro]) -> str:
     if len(mine) == 1:
         return f"build: {slot_name(mine[0].slot)}, {_count(mine[0])} (copy the MD line)"
-    return (f"build: {', '.join(slot_name(m.slot) for m in mine)} "
+    return (f"build: {_slots(mine)} "
             f"(copy {len(mine)} MD lines)")
+
+
+def _slots(mine: list[Macro]) -> str:
+    return ", ".join(slot_name(m.slot) for m in mine)
 
 
 def of_macro(name: str, program: Program) -> list[Macro]:

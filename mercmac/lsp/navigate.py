@@ -52,7 +52,7 @@ def _meanings(seen: Seen, line: int, column: int):
     if use is not None and use.kind == "slot":
         yield symbols.slot_help(use.slot, program), use.span
     elif use is not None:
-        yield (symbols.macro_help(use.name, program) if use.kind == "macro"
+        yield (symbols.macro_help(use.name, program, seen.errors > 0) if use.kind == "macro"
                else symbols.const_help(use.name, items)), use.span
     if command is not None:
         yield (symbols.command_help(command.word) or f"unknown command '{command.word}'",

@@ -74,6 +74,11 @@ class Seen:
         return self.checked.compilation
 
     @property
+    def errors(self) -> int:
+        """How many errors `check` reports: with one, `build` writes nothing."""
+        return sum(d.severity is Severity.ERROR for d in self.diagnostics)
+
+    @property
     def items(self) -> tuple:
         """The AST's items; with syntax errors, those of every block as far as it parses
         (the re-checker keeps only the blocks without errors), so that a block being

@@ -145,8 +145,9 @@ def command_help(mnemonic: str) -> str | None:
     return text(mnemonic)
 
 
-def macro_help(name: str, program: Program | None) -> str:
-    """Hover text of a macro name: its slots after lowering, their MD lines, its callers."""
+def macro_help(name: str, program: Program | None, errors: bool = False) -> str:
+    """Hover text of a macro name: its slots after lowering, their MD lines (as `build`
+    writes them, or as lowered so far when the file has `errors`), its callers."""
     lines = [f"**macro {name}**"]
     if program is None:
         return lines[0] + _UNLOWERED
@@ -156,6 +157,9 @@ def macro_help(name: str, program: Program | None) -> str:
     lines += ["", f"slot{'s' if len(mine) > 1 else ''}: "
               + ", ".join(slot_name(m.slot) for m in mine), "", "```", *(m.md for m in mine), "```",
               "", lowered.count_lines(mine), "", _called_by(mine[0].slot, program)]
+    if errors:
+        lines += ["", "(as lowered so far: `mercmac build` writes nothing while the file "
+                      "has errors)"]
     return "\n".join(lines)
 
 

@@ -129,9 +129,11 @@ def code_lenses(ls: MercmacServer, params: t.CodeLensParams) -> list[t.CodeLens]
     if seen.rig:
         return []
     document: Document = ls.workspace.get_text_document(uri)
+    # a lens with no lines to copy is a label: an empty command, which editors show unclickable
     return [t.CodeLens(range=t.Range(document.position(lens.line, 1),
                                      document.position(lens.line, 1)),
-                       command=t.Command(title=lens.title, command=lowered.COPY_BUILD,
+                       command=t.Command(title=lens.title,
+                                         command=lowered.COPY_BUILD if lens.lines else "",
                                          arguments=[{"macro": lens.macro,
                                                      "lines": list(lens.lines)}]))
-            for lens in lowered.lenses(seen.items, seen.compilation.program)]
+            for lens in lowered.lenses(seen.items, seen.compilation.program, seen.errors)]

@@ -110,6 +110,7 @@ async def test_inlay_hints_show_each_slot_and_the_budget(client: LanguageClient,
     assert shown == {f"MC{int(line.split(',')[0][2:]):02d}" for line in built}
     budget = next(h for h in hints if h.position.line == 0)
     assert "free: MC" in budget.tooltip.value
+    assert budget.position.character == len(lines[0])  # after the line, a comment included
 
 
 @pytest.mark.asyncio
@@ -142,6 +143,21 @@ async def test_the_build_lens_and_the_hover_hold_the_md_lines_build_writes(
     jog = by_line[10].arguments[0]["lines"]
     assert all(line in text for line in jog)
     assert "MC02: 5 of 16 commands" in text
+
+
+@pytest.mark.asyncio
+async def test_with_errors_the_lens_says_build_writes_nothing(client: LanguageClient, tmp_path):
+    path = tmp_path / "typo.mcm"
+    text = "macro scan { MR 5, MX 1 }\nautostart { call scan }\n"
+    await _open(client, path, text)
+    lenses = await client.text_document_code_lens_async(t.CodeLensParams(
+        text_document=t.TextDocumentIdentifier(uri=path.as_uri())))
+    assert [(lens.command.title, lens.command.command) for lens in lenses] == [
+        ("build: MC01, not built while the file has 1 error", ""),
+        ("build: MC00, not built while the file has 1 error", "")]
+    hover = await client.text_document_hover_async(t.HoverParams(
+        text_document=t.TextDocumentIdentifier(uri=path.as_uri()), position=t.Position(1, 18)))
+    assert "`mercmac build` writes nothing while the file has errors" in hover.contents.value
 
 
 @pytest.mark.asyncio

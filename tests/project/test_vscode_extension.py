@@ -31,7 +31,7 @@ STAMP = VSCODE / "node_modules" / ".mercmac-lock-sha256"
 # turns (scheduling them on one worker, `xdist_group`, does nothing under pytest 9).
 # What the .vsix holds (vsce's own files aside): the bundle, never the sources or the tests.
 PACKAGED = {"extension/package.json", "extension/readme.md", "extension/LICENSE.txt",
-            "extension/icon.png", "extension/dist/extension.js",
+            "extension/icon.png", "extension/icons/mcm.svg", "extension/dist/extension.js",
             "extension/language-configuration.json", "extension/syntaxes/mcm.tmLanguage.json"}
 
 
@@ -47,6 +47,7 @@ def test_the_extension_names_its_files():
     assert (VSCODE / package["icon"]).exists() and (VSCODE / "LICENSE").exists()
     assert (VSCODE / package["contributes"]["grammars"][0]["path"]).exists()
     assert (VSCODE / package["contributes"]["languages"][0]["configuration"]).exists()
+    assert all((VSCODE / icon).exists() for icon in package["contributes"]["languages"][0]["icon"].values())
     assert (VSCODE / "package-lock.json").exists()
     ignored = (VSCODE / ".gitignore").read_text(encoding="utf-8").split()
     assert {"node_modules/", "dist/"} <= set(ignored)

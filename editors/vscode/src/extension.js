@@ -1,105 +1,145 @@
 // The client: VS Code starts `mercmac lsp --stdio` (the language server over stdio) for .mcm
-// documents and rig files (*.rig.toml). vscode-languageclient appends `--stdio` itself for
-// TransportKind.stdio.
+// documents and rig files (*.rig.toml), once the workspace is trusted.
 // Bundled by esbuild into dist/extension.js (`npm run build`), which is what the .vsix holds.
+//   session.js   one client and its server processes; failures reported once
+//   server.js    the server process (spawned here, to keep its standard error)
+//   status.js    the language status item
+//   messages.js  what a failure says
+//   commands.js  copyBuild (the code lens's command), --version
 "use strict";
-const fs = require("fs");
-const path = require("path");
 const vscode = require("vscode");
-const { LanguageClient, TransportKind } = require("vscode-languageclient/node");
+const { Session, clientOptions } = require("./session");
+const { Status } = require("./status");
+const { describeFailure, INSTALL_HINT } = require("./messages");
+const { copyBuild, askVersion } = require("./commands");
+const { locate } = require("./server");
 
-const INSTALL_HINT =
-  "Install it with `pip install 'mercmac[lsp]'`, or set the `mercmac.path` setting to the " +
-  "mercmac executable (for a virtual environment: `.venv/bin/mercmac`).";
-
-let client;
+// For the extension's life (activate to deactivate): one log channel, whatever the number
+// of restarts; the status item; the current session.
+let channel;
+let status;
+let session;
+let queue = Promise.resolve(); // see enqueue
+let active = false;
 
 /** The executable the `mercmac.path` setting names ("mercmac" on PATH by default). */
 function executable() {
   return vscode.workspace.getConfiguration("mercmac").get("path") || "mercmac";
 }
 
-/** What starts the server: `<path> lsp`, to which the client adds `--stdio`. */
-function serverOptions(command) {
-  return { command, args: ["lsp"], transport: TransportKind.stdio };
+/** The first workspace folder on disk: the server's working directory, and where a relative
+ *  mercmac.path (.venv/bin/mercmac) is found. */
+function folder() {
+  const first = (vscode.workspace.workspaceFolders || [])[0];
+  return first && first.uri && first.uri.scheme === "file" ? first.uri.fsPath : undefined;
 }
 
-function clientOptions() {
-  return {
-    documentSelector: [
-      { scheme: "file", language: "mcm" },
-      { scheme: "untitled", language: "mcm" },
-      // rig files (several controllers on one link): TOML, whatever language an editor
-      // gives them, so matched by name; the server checks them as `mercmac check RIG` does
-      { scheme: "file", pattern: "**/*.rig.toml" },
-    ],
-    // the server asks for the `mercmac` section (target, select, ignore) through
-    // workspace/configuration and is told of changes to it
-    synchronize: { configurationSection: "mercmac" },
-  };
+/** One error notification, with the buttons that fix it. */
+async function showFailure(failure) {
+  const missing = failure.kind === "not-found" || failure.kind === "not-executable";
+  const actions = missing ? ["Open Settings", "Restart Server"] : ["Show Server Log", "Open Settings"];
+  const choice = await vscode.window.showErrorMessage(failure.text, ...actions);
+  if (choice === "Open Settings") {
+    await vscode.commands.executeCommand("workbench.action.openSettings", "mercmac.path");
+  } else if (choice === "Show Server Log") {
+    channel.show(true);
+  } else if (choice === "Restart Server") {
+    await restart();
+  }
 }
 
-/** Whether COMMAND names an executable file, itself or on PATH (with PATHEXT on Windows),
- *  so that a missing one gets our message instead of the client's "couldn't create connection". */
-function findable(command) {
-  const windows = process.platform === "win32";
-  const endings = windows ? ["", ...(process.env.PATHEXT || ".EXE;.CMD;.BAT").split(";")] : [""];
-  const folders = command.includes("/") || (windows && command.includes("\\"))
-    ? [""] : (process.env.PATH || "").split(path.delimiter);
-  return folders.some((folder) => endings.some((ending) => {
-    try {
-      fs.accessSync(path.join(folder, command + ending), windows ? fs.constants.F_OK : fs.constants.X_OK);
-      return fs.statSync(path.join(folder, command + ending)).isFile();
-    } catch {
-      return false;
+const events = {
+  starting: (s) => s === session && status.starting(s.where()),
+  running: (s) => s === session && status.running(s.version(), s.where()),
+  failed: (s, failure) => {
+    if (s === session) {
+      status.failed(failure, s.where());
+      void showFailure(failure);
     }
-  }));
-}
+  },
+};
 
-/** Why the server did not start, in words a user can act on. */
-function startFailure(command, error) {
-  const text = String((error && error.message) || error);
-  if (/ENOENT/.test(text)) {
-    return `mercmac: cannot start the language server: '${command}' was not found. ${INSTALL_HINT}`;
-  }
-  if (/EACCES/.test(text)) {
-    return `mercmac: cannot start the language server: '${command}' is not executable. ${INSTALL_HINT}`;
-  }
-  return `mercmac: the language server '${command} lsp' did not start: ${text}. ${INSTALL_HINT}`;
-}
-
-/** Start a client for the current setting; a failure is shown, not thrown. */
+/** Start a session for the current setting; a failure is shown, not thrown. */
 async function start() {
-  const command = executable();
-  if (!findable(command)) {
-    vscode.window.showErrorMessage(startFailure(command, new Error("ENOENT")));
-    return undefined;
-  }
-  const made = new LanguageClient("mercmac", "mercmac", serverOptions(command), clientOptions());
-  client = made;
-  try {
-    await made.start();
-  } catch (error) {
-    if (client === made) {
-      client = undefined;
-    }
-    vscode.window.showErrorMessage(startFailure(command, error));
-  }
+  const made = new Session(executable(), folder(), channel, events);
+  session = made;
+  await made.start();
   return made;
 }
 
-/** Stop the running client (if any) and start one for the new setting. */
-async function restart() {
-  const old = client;
-  client = undefined;
+/** Run STEP after the steps before it (restarts, the stop at deactivate): never two
+ *  sessions at once, and none started after deactivate. */
+function enqueue(step) {
+  queue = queue.then(step).catch((error) => {
+    channel.appendLine(`[mercmac] ${(error && error.stack) || error}`);
+  });
+  return queue;
+}
+
+async function stopSession() {
+  const old = session;
+  session = undefined;
   if (old) {
-    await old.stop().catch(() => undefined);
+    await old.dispose();
   }
-  return start();
+}
+
+/** Dispose of the running session (if any) and start one for the current setting. */
+function restart() {
+  return enqueue(async () => {
+    await stopSession();
+    if (!active) {
+      return undefined;
+    }
+    if (!vscode.workspace.isTrusted) {
+      status.waiting();
+      return undefined;
+    }
+    return start();
+  });
+}
+
+/** mercmac.showVersion: the running server's version, else what the executable says. */
+async function showVersion() {
+  if (!vscode.workspace.isTrusted) {
+    void vscode.window.showInformationMessage(
+      "mercmac: waiting for workspace trust; in Restricted Mode mercmac is not run, so its version is not known.");
+    return;
+  }
+  const command = session ? session.command : executable();
+  const where = locate(command, folder()) || command;
+  if (session && session.running() && session.version()) {
+    void vscode.window.showInformationMessage(
+      `mercmac ${session.version()} (${where}) is the running language server.`);
+    return;
+  }
+  if (!locate(command, folder())) {
+    void vscode.window.showInformationMessage(`mercmac: '${command}' was not found. ${INSTALL_HINT}`);
+    return;
+  }
+  let said;
+  try {
+    said = `mercmac ${await askVersion(where, folder())} (${where})`;
+  } catch (error) {
+    said = `mercmac: '${where} --version' failed: ${error.message}`;
+  }
+  const why = status.reason || "it is not running";
+  void vscode.window.showInformationMessage(`${said}; the language server is not running: ${why}.`);
 }
 
 function activate(context) {
+  channel = vscode.window.createOutputChannel("mercmac");
+  status = new Status();
+  session = undefined;
+  queue = Promise.resolve();
+  active = true;
   context.subscriptions.push(
+    channel,
+    status,
+    vscode.commands.registerCommand("mercmac.restartServer", () => restart()),
+    vscode.commands.registerCommand("mercmac.showServerLog", () => channel.show(true)),
+    vscode.commands.registerCommand("mercmac.showVersion", () => showVersion()),
+    vscode.commands.registerCommand("mercmac.copyBuild", (argument) => copyBuild(argument)),
     vscode.workspace.onDidChangeConfiguration((event) => {
       if (event.affectsConfiguration("mercmac.path")) {
         return restart();
@@ -107,13 +147,24 @@ function activate(context) {
       return undefined;
     }),
   );
-  return start();
+  if (!vscode.workspace.isTrusted) {
+    // Restricted Mode: highlighting works, but no executable is run until the user trusts
+    // the workspace (a workspace setting could name any program as mercmac.path)
+    status.waiting();
+    context.subscriptions.push(vscode.workspace.onDidGrantWorkspaceTrust(() => restart()));
+    return undefined;
+  }
+  return restart();
 }
 
 function deactivate() {
-  const old = client;
-  client = undefined;
-  return old ? old.stop() : undefined;
+  active = false;
+  return enqueue(stopSession);
 }
 
-module.exports = { activate, deactivate, startFailure, clientOptions, current: () => client };
+/** The running client, if any (for the tests). */
+function current() {
+  return session && session.running() ? session.client : undefined;
+}
+
+module.exports = { activate, deactivate, clientOptions, current, describeFailure };

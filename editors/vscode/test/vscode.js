@@ -49,17 +49,46 @@ function inert(name) {
   });
 }
 
-/** A fresh `vscode` with SETTINGS ({"mercmac.path": ...}); `seen` records what was shown. */
-function makeVscode(settings) {
-  const seen = { errors: [], infos: [], output: [] };
+/** An object whose missing members are inert values (the parts of a namespace no test needs). */
+function withInert(object, name) {
+  return new Proxy(object, {
+    get(target, prop) {
+      if (!(prop in target)) target[prop] = inert(`${name}.${String(prop)}`);
+      return target[prop];
+    },
+  });
+}
+
+/**
+ * A fresh `vscode` with SETTINGS ({"mercmac.path": ...}); `seen` records what was shown:
+ * errors (error and warning messages), infos, messages ({kind, text, items}), output (text
+ * written to any channel), channels (every createOutputChannel), statusItems, executed
+ * commands, the clipboard. OPTIONS: trusted (workspace trust, default true), answer(message,
+ * items) picks the button a message gets (default: none).
+ */
+function makeVscode(settings, options = {}) {
+  const seen = { errors: [], infos: [], messages: [], output: [], channels: [], statusItems: [],
+                 executed: [], clipboard: undefined };
   const configuration = new EventEmitter();
+  const trust = new EventEmitter();
+  const commands = new Map();
   const none = () => new Disposable();
+  const answer = options.answer || (() => undefined);
+  function show(kind, list) {
+    return (text, ...items) => {
+      list.push(text);
+      seen.messages.push({ kind, text, items });
+      return Promise.resolve(answer(text, items));
+    };
+  }
   const api = {
     version: "1.90.0",
     env: { appName: "Visual Studio Code", language: "en", machineId: "test", sessionId: "test",
-           uriScheme: "vscode", shell: "/bin/sh", uiKind: 1 },
+           uriScheme: "vscode", shell: "/bin/sh", uiKind: 1,
+           clipboard: { writeText: async (text) => (seen.clipboard = text), readText: async () => seen.clipboard } },
     EventEmitter,
     Disposable,
+    LanguageStatusSeverity: { Information: 0, Warning: 1, Error: 2 },
     workspace: {
       getConfiguration: (section) => ({
         get: (key, fallback) => {
@@ -68,6 +97,8 @@ function makeVscode(settings) {
         },
       }),
       onDidChangeConfiguration: configuration.event,
+      isTrusted: options.trusted !== false,
+      onDidGrantWorkspaceTrust: trust.event,
       textDocuments: [],
       notebookDocuments: [],
       workspaceFolders: undefined,
@@ -79,29 +110,53 @@ function makeVscode(settings) {
       onDidChangeWorkspaceFolders: none,
     },
     window: {
-      createOutputChannel: (name) => ({
-        name,
-        append: (text) => seen.output.push(text),
-        appendLine: (text) => seen.output.push(`${text}\n`),
-        show() {}, hide() {}, clear() {}, replace() {}, dispose() {},
-      }),
-      showErrorMessage: (message) => (seen.errors.push(message), Promise.resolve(undefined)),
-      showWarningMessage: (message) => (seen.errors.push(message), Promise.resolve(undefined)),
-      showInformationMessage: (message) => (seen.infos.push(message), Promise.resolve(undefined)),
+      createOutputChannel: (name) => {
+        const channel = {
+          name, shown: 0, disposed: false,
+          append: (text) => seen.output.push(text),
+          appendLine: (text) => seen.output.push(`${text}\n`),
+          show() { channel.shown += 1; }, hide() {}, clear() {}, replace() {},
+          dispose() { channel.disposed = true; },
+        };
+        seen.channels.push(channel);
+        return channel;
+      },
+      showErrorMessage: show("error", seen.errors),
+      showWarningMessage: show("warning", seen.errors),
+      showInformationMessage: show("info", seen.infos),
     },
+    commands: {
+      registerCommand: (id, handler) => {
+        if (commands.has(id)) throw new Error(`command '${id}' already exists`);
+        commands.set(id, handler);
+        return new Disposable(() => commands.delete(id));
+      },
+      executeCommand: async (id, ...args) => {
+        seen.executed.push([id, ...args]);
+        return commands.has(id) ? commands.get(id)(...args) : undefined;
+      },
+      getCommands: async () => [...commands.keys()],
+    },
+    languages: withInert({
+      createLanguageStatusItem: (id, selector) => {
+        const item = { id, selector, text: "", disposed: false, dispose() { item.disposed = true; } };
+        seen.statusItems.push(item);
+        return item;
+      },
+    }, "vscode.languages"),
   };
-  const vscode = new Proxy(api, {
-    get(target, prop) {
-      if (!(prop in target)) target[prop] = inert(`vscode.${String(prop)}`);
-      return target[prop];
-    },
-  });
+  const vscode = withInert(api, "vscode");
   /** Change a setting as the Settings editor does, and tell the listeners. */
   function change(key, value) {
     settings[key] = value;
     configuration.fire({ affectsConfiguration: (section) => key === section || key.startsWith(`${section}.`) });
   }
-  return { vscode, seen, change };
+  /** Trust the workspace, as the user does in the Restricted Mode banner. */
+  function grantTrust() {
+    api.workspace.isTrusted = true;
+    trust.fire();
+  }
+  return { vscode, seen, change, grantTrust };
 }
 
 // esbuild's bundle requires `vscode` lazily (when a bundled module first runs), so the
@@ -117,4 +172,38 @@ function requireWith(vscode, path) {
   return require(path);
 }
 
-module.exports = { makeVscode, requireWith };
+const BUNDLE = require("node:path").join(__dirname, "..", "dist", "extension.js");
+
+/** The bundle activated in a fresh stand-in (SETTINGS, OPTIONS as makeVscode's). */
+async function activated(settings, options) {
+  const editor = makeVscode(settings, options);
+  const extension = requireWith(editor.vscode, BUNDLE);
+  const context = { subscriptions: [] };
+  active.push(extension);
+  await extension.activate(context);
+  return { ...editor, extension, context };
+}
+
+// Extensions activated and not yet deactivated: a failed test leaves its server running,
+// which would keep the test process alive.
+const active = [];
+
+/** Deactivate what `activated` activated (test.afterEach: even after a failure). */
+async function deactivateAll() {
+  while (active.length) await active.pop().deactivate();
+}
+
+/** PROBE's first truthy value, asked every 50 ms for up to MS milliseconds. */
+async function waitFor(probe, ms = 20000) {
+  const end = Date.now() + ms;
+  for (;;) {
+    const value = probe();
+    if (value) return value;
+    if (Date.now() > end) throw new Error(`timed out waiting for ${probe}`);
+    await new Promise((resolve) => setTimeout(resolve, 50));
+  }
+}
+
+const pause = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+
+module.exports = { makeVscode, requireWith, activated, deactivateAll, waitFor, pause, BUNDLE };
