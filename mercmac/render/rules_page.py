@@ -11,9 +11,6 @@ from mercmac.diagnostics import Rule
 
 # Where docs/rules.md is published: the project's repository (editors/vscode/package.json).
 PAGE = "https://github.com/mercmac/mercmac/blob/main/docs/rules.md"
-_SECTIONS = (("MM", "Program rules (MM)", "what `mercmac check` reports in a program"),
-             ("MR", "Rig rules (MR)", "what `mercmac check RIG` reports in a rig file"),
-             ("MH", "Runtime hazards (MH)", "what `mercmac sim` reports while it runs"))
 
 
 def url(rule: Rule) -> str:
@@ -29,14 +26,19 @@ def anchor(rule: Rule) -> str:
 
 def markdown() -> str:
     """The page: per kind of rule, each rule's code, name, severity, summary and story."""
-    rules = diagnostics.RULES + hazards.RULES
+    program = tuple(r for r in diagnostics.RULES if r.code.startswith("MM"))
+    sections = (("Program rules (MM)", "what `mercmac check` reports in a program", program),
+                ("Rig rules (MR)", "what `mercmac check RIG` reports in a rig file",
+                 tuple(r for r in diagnostics.RULES if r not in program)),
+                ("Runtime hazards (MH)", "what `mercmac sim` reports while it runs",
+                 hazards.RULES))
     out = ["# Rules", "",
            "What `mercmac explain CODE` prints for each rule, written by "
            "`python -m mercmac.render.rules_page`. [checks.md](checks.md) says how rules are "
            "chosen and turned off.", ""]
-    for prefix, title, what in _SECTIONS:
+    for title, what, rules in sections:
         out += [f"## {title}", "", f"{what[0].upper()}{what[1:]}.", ""]
-        for rule in (r for r in rules if r.code.startswith(prefix)):
+        for rule in rules:
             out += [f"### {rule.code} {rule.name}", "",
                     f"*{rule.severity}*: {rule.summary}", "",
                     "```text", *rule.explanation.splitlines(), "```", ""]
