@@ -332,6 +332,11 @@ def main(say: Callable[[str], None]) -> None:
     server.start_io()
 
 
+# pygls's warning when the client cancels a request already answered: editors do it all
+# the time (a hover the cursor left), and nothing went wrong.
+_ANSWERED_CANCEL = 'Cancel notification for unknown message id "%s"'
+
+
 class _Said(logging.Handler):
     """pygls's and asyncio's warnings and errors, one line each through `say`."""
 
@@ -341,8 +346,8 @@ class _Said(logging.Handler):
 
     def emit(self, record: logging.LogRecord) -> None:
         error = record.exc_info[1] if record.exc_info else None
-        if isinstance(error, Refusal):  # answered to the client; nothing went wrong here
-            return
+        if isinstance(error, Refusal) or record.msg == _ANSWERED_CANCEL:
+            return  # answered to the client; nothing went wrong here
         text = split_lines(record.getMessage())[0][:300]
         if error is not None:
             text += f": {type(error).__name__}: {error}"[:300]

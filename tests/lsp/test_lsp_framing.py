@@ -85,3 +85,19 @@ def test_a_request_with_bad_params_is_answered_with_an_error():
     finally:
         server.close()
     assert "Invalid Params" in _said_without_traceback(server)[-1]
+
+
+def test_a_cancel_of_an_answered_request_is_not_logged():
+    """Editors cancel requests the server has answered already (VS Code does it on every
+    fast typist's hover): nothing went wrong, so the log the user opens stays quiet."""
+    server = Server()
+    try:
+        server.write(frame(INITIALIZE))
+        assert server.answer(1) is not None
+        server.write(frame(notification("initialized", {})) + frame(OPEN) + frame(hover(2)))
+        assert server.answer(2) is not None
+        server.write(frame(notification("$/cancelRequest", {"id": 2})) + frame(hover(3)))
+        assert server.answer(3) is not None
+    finally:
+        server.close()
+    assert _said_without_traceback(server) == []
