@@ -12,6 +12,9 @@ Then a large document (2.5 MB; once 11.3 s to the first diagnostics and 3.5 s pe
 edit) through a real `mercmac lsp` over pipes: the time from didOpen to the first
 diagnostics, from each one-character didChange to its diagnostics, and for a burst of
 edits sent at once, to the diagnostics of the last. Goal: linear, at most 2 s per MB.
+Then what an editor asks of that document after each change besides diagnostics (semantic
+tokens, folding, inlay hints of the whole text, code lenses): seconds to each answer, with
+the same goal.
 """
 from __future__ import annotations
 
@@ -114,11 +117,39 @@ def server_latency(text: str, edits: int = 5, burst: int = 10) -> None:
         per_edit = [_timed(server, v, _keystroke(uri, v, middle)) for v in range(2, 2 + edits)]
         versions = range(2 + edits, 2 + edits + burst)
         last = _timed(server, versions[-1], *(_keystroke(uri, v, middle) for v in versions))
+        views = _views(server, uri, text.count("\n") + 1)
     finally:
         server.close()
     print(f"{mb:.1f} MB through `mercmac lsp`: first diagnostics {opened:.2f} s "
           f"({opened / mb:.2f} s/MB, goal <= 2), per edit median "
           f"{statistics.median(per_edit):.2f} s, {burst} edits at once {last:.2f} s")
+    print("  then, of the same version: " + ", ".join(
+        f"{name} {seconds:.2f} s ({seconds / mb:.2f} s/MB)" for name, seconds in views.items()))
+
+
+# What an editor asks after a change besides diagnostics (VS Code asks each of them).
+_VIEWS = {"semantic tokens": ("textDocument/semanticTokens/full", {}),
+          "folding": ("textDocument/foldingRange", {}),
+          "inlay hints": ("textDocument/inlayHint", None),
+          "code lenses": ("textDocument/codeLens", {})}
+
+
+def _views(server, uri: str, lines: int) -> dict[str, float]:
+    """Seconds to the answer of each request of _VIEWS, one after the other."""
+    from helpers.lsp_wire import frame, request
+
+    out = {}
+    for number, (name, (method, params)) in enumerate(_VIEWS.items(), start=100):
+        params = dict(params if params is not None else {"range": {
+            "start": {"line": 0, "character": 0}, "end": {"line": lines, "character": 0}}})
+        params["textDocument"] = {"uri": uri}
+        start = time.perf_counter()
+        server.write(frame(request(number, method, params)))
+        answer = server.wait(lambda m, n=number: m.get("id") == n and "method" not in m,
+                             f"{name}", wait_s=600)
+        assert answer is not None and "error" not in answer, answer
+        out[name] = time.perf_counter() - start
+    return out
 
 
 def _keystroke(uri: str, version: int, line: int) -> dict:

@@ -60,14 +60,20 @@ class Document(TextDocument):
     def position(self, line: int, column: int) -> t.Position:
         """The LSP position of a 1-based line and column: a column past the end of its line
         means the end of the line, a line past the last one the end of the text."""
+        return t.Position(*self.units(line, column))
+
+    def units(self, line: int, column: int) -> tuple[int, int]:
+        """`position` as (line, character), without making a Position: semantic tokens
+        send hundreds of thousands of them as plain integers."""
         _, lines = self._lines_of_source()
         if line > len(lines):
-            return self.end()
+            end = self.end()
+            return end.line, end.character
         if line < 1:
-            return t.Position(0, 0)
+            return 0, 0
         text = lines[line - 1]
         head = text[:min(max(column - 1, 0), len(text))]
-        return t.Position(line - 1, len(head) if head.isascii()
+        return line - 1, (len(head) if head.isascii()
                           else self.position_codec.client_num_units(head))
 
     def range_of(self, span: Span) -> t.Range:

@@ -60,7 +60,7 @@ def tokens(items: tuple, source: Source) -> list[Token]:
             found += _statements(item.body)
     found = [tok._replace(modifiers=tok.modifiers + ("raw",)) if tok.span.line in raw_lines
              else tok for tok in found]
-    return sorted(found, key=lambda tok: (tok.span.line, tok.span.column))
+    return sorted(found)  # by span: line, then column (a Token is a tuple, its span first)
 
 
 def _named(use: symbols.Use) -> Token:
@@ -68,17 +68,20 @@ def _named(use: symbols.Use) -> Token:
     return Token(use.span, kind, modifiers + (("declaration",) if use.defines else ()))
 
 
-def _statements(body: tuple) -> list[Token]:
-    found = []
+def _statements(body: tuple, found: list | None = None) -> list[Token]:
+    """The tokens of a body's statements, nested ones too, added to `found`."""
+    found = [] if found is None else found
     for s in body:
         if isinstance(s, ast.Command):
             found += _command(s)
-        elif isinstance(s, ast.When):
-            found += [_number(c.value) for c in s.conditions]
+            continue
+        if isinstance(s, ast.When):
+            found += filter(None, (_number(c.value) for c in s.conditions))
         elif isinstance(s, (ast.Repeat, ast.Every)):
-            found.append(_number(s.count if isinstance(s, ast.Repeat) else s.period))
-        found += _statements(getattr(s, "body", ()))
-    return [tok for tok in found if tok is not None]
+            number = _number(s.count if isinstance(s, ast.Repeat) else s.period)
+            found += [number] if number else []
+        _statements(getattr(s, "body", ()), found)
+    return found
 
 
 def _command(c: ast.Command) -> list[Token]:
@@ -105,12 +108,11 @@ def encode(found: list[Token], document) -> list[int]:
         s = tok.span
         if (s.end_line or s.line) != s.line:
             continue
-        start, stop = document.position(s.line, s.column), document.position(s.line, s.end_column)
-        if start.line != stop.line or stop.character <= start.character \
-                or (start.line, start.character) < reached:
+        start, stop = document.units(s.line, s.column), document.units(s.line, s.end_column)
+        if start[0] != stop[0] or stop[1] <= start[1] or start < reached:
             continue
-        data += [start.line - line, start.character - (character if start.line == line else 0),
-                 stop.character - start.character, TYPES.index(tok.type),
+        data += [start[0] - line, start[1] - (character if start[0] == line else 0),
+                 stop[1] - start[1], TYPES.index(tok.type),
                  sum(1 << MODIFIERS.index(m) for m in tok.modifiers)]
-        line, character, reached = start.line, start.character, (stop.line, stop.character)
+        (line, character), reached = start, stop
     return data

@@ -13,8 +13,8 @@ async function copyBuild(argument) {
     return;
   }
   await vscode.env.clipboard.writeText(lines.join("\n"));
-  const count = `${lines.length} line${lines.length === 1 ? "" : "s"}`;
-  void vscode.window.showInformationMessage(`Copied the MD line(s) of ${argument.macro} (${count})`);
+  const what = lines.length === 1 ? "the MD line" : `the ${lines.length} MD lines`;
+  void vscode.window.showInformationMessage(`Copied ${what} of ${argument.macro}`);
 }
 
 /** What `COMMAND --version` says ("mercmac, version 0.1.0" gives "0.1.0"), or throws. */

@@ -60,10 +60,10 @@ test("copyBuild copies the lens's MD lines and says so", async () => {
   await vscode.commands.executeCommand("mercmac.copyBuild",
     { macro: "scan", lines: ["MD0,MR1000", "MD0,WS", "MD0,MR-1000"] });
   assert.strictEqual(seen.clipboard, "MD0,MR1000\nMD0,WS\nMD0,MR-1000");
-  assert.deepStrictEqual(seen.infos, ["Copied the MD line(s) of scan (3 lines)"]);
+  assert.deepStrictEqual(seen.infos, ["Copied the 3 MD lines of scan"]);
   await vscode.commands.executeCommand("mercmac.copyBuild", { macro: "home", lines: ["MD1,FE2"] });
   assert.strictEqual(seen.clipboard, "MD1,FE2");
-  assert.strictEqual(seen.infos[1], "Copied the MD line(s) of home (1 line)");
+  assert.strictEqual(seen.infos[1], "Copied the MD line of home");
 });
 
 test("Show Server Log shows the one log channel", async () => {

@@ -106,7 +106,7 @@ export async function featureChecks(session, options) {
     }, { timeout: 10000 }).catch(() => {
       throw new Error(`after clicking the lens the clipboard holds ${JSON.stringify(clipboard)}, not ${JSON.stringify(want.join("\n"))}`);
     });
-    const note = await waitNotification(session, /Copied the MD line\(s\) of jog/, "the notification");
+    const note = await waitNotification(session, /Copied the 5 MD lines of jog/, "the notification");
     c.shots.push(await session.shot("14-code-lens-copied"));
     c.note(`lens "${lens.title}" on line ${header.line + 1} clicked: the clipboard holds ${want.length} lines equal to \`mercmac build\`'s (${want.map((l) => l.split(",")[0]).join(", ")}); notification ${JSON.stringify(note)}`);
     await clearNotifications(session);
