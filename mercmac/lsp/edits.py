@@ -99,7 +99,7 @@ def _formatted(ls: MercmacServer, uri: str, path: str) -> tuple[t.TextEdit | Non
 
 
 @features.on(t.TEXT_DOCUMENT_CODE_ACTION,
-                t.CodeActionOptions(code_action_kinds=[t.CodeActionKind.QuickFix, ADD_TARGET]))
+             t.CodeActionOptions(code_action_kinds=[t.CodeActionKind.QuickFix, ADD_TARGET]))
 def code_actions(ls: MercmacServer, params: t.CodeActionParams) -> list[t.CodeAction]:
     """The fixes of the reported diagnostics in the range (the Fix data of each, as
     `check --fix` makes them); in a file without `target`, a source action that adds one."""

@@ -69,7 +69,7 @@ def _meanings(seen: Seen, line: int, column: int):
 
 
 @features.on(t.TEXT_DOCUMENT_COMPLETION,
-                t.CompletionOptions(trigger_characters=[" ", ","]))
+             t.CompletionOptions(trigger_characters=[" ", ","]))
 def completion(ls: MercmacServer, params: t.CompletionParams) -> t.CompletionList:
     """The words that may stand at the cursor (mercmac.lsp.completion)."""
     uri = params.text_document.uri

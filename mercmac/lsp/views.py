@@ -48,7 +48,7 @@ def folding_ranges(ls: MercmacServer, params: t.FoldingRangeParams) -> list[t.Fo
 
 
 @features.on(t.TEXT_DOCUMENT_SIGNATURE_HELP,
-                t.SignatureHelpOptions(trigger_characters=[" ", ","]))
+             t.SignatureHelpOptions(trigger_characters=[" ", ","]))
 def signature_help(ls: MercmacServer, params: t.SignatureHelpParams) -> t.SignatureHelp | None:
     """The command whose argument is typed, for the file's model (mercmac.lsp.signature)."""
     uri = params.text_document.uri
