@@ -24,7 +24,6 @@ from mercmac.cli.common import UsageError
 from mercmac.commands import unit
 from mercmac.render import sim as render
 from mercmac.render.console import write_lines
-from mercmac.vm import events as ev
 from mercmac.sim.simulate import Run, Simulation
 
 TICK_S = 0.05  # redraw period
@@ -34,8 +33,6 @@ COUNTDOWN_S = 2.0  # long enough to press a key or two before power-on, short en
 HELP = ("keys 1-4: press/release a button (5, 6: joystick, joystick button) - r: reset "
         "(power-on) - q: quit")
 CLEAR = "\r\x1b[K"  # carriage return, erase to the end of the line (ECMA-48 EL)
-SHOWN = (ev.InputChanged, ev.JoystickMoved, ev.OutputsChanged, ev.Reported, ev.HazardFound,
-         ev.MoveStarted, ev.MoveEnded, ev.HomeDefined, ev.ProgramEnded)
 
 
 def run(sim: Simulation, box: str, *, speed: float = 1.0, hold: tuple[int, ...] = (),
@@ -152,7 +149,8 @@ def _advance(sim: Simulation, t_ms: float, deadline: float) -> None:
 
 def _show(pending: list, machine, out: IO[str]) -> None:
     """Print what happened since the last tick above the status line, then redraw it."""
-    lines = [render.event_line(e, unit(machine.model)) for e in pending if isinstance(e, SHOWN)]
+    lines = [render.event_line(e, unit(machine.model)) for e in pending
+             if isinstance(e, render.LIVE_EVENTS)]
     pending.clear()
     if lines:
         out.write(CLEAR)

@@ -51,6 +51,9 @@ class Request:
     verbose: int = 0  # timeline: 0 the story, 1 with macro entries and exits, 2 everything
     fail_on_hazard: bool = False
     hold: str = ""  # --interactive: inputs held at power-on, e.g. "2" or "2+3"
+    web: bool = False  # the box in the browser (mercmac.web)
+    port: int = 0  # --web: 0, a free one
+    open_page: bool = True  # --web: open the default browser on the page
     joystick: str = ""  # a rig: NAME=D@T1-T2,...
     allow_hazard: tuple[str, ...] = ()  # hazard rules accepted for the run
 
@@ -111,6 +114,8 @@ def _run(req: Request) -> bool:
     programs = {name: c.program for name, c in accepted.programs.items()}
     if req.interactive:
         return _interactive(req, rig, programs, script, options)
+    if req.web:
+        return _web(req, rig, programs, script, options)
     if req.scenario:
         return _scenario(req, rig, programs, script, options)
     until = _until(req.until, None)
@@ -316,6 +321,50 @@ def _interactive(req: Request, rig: Rig, programs: dict, script: Script,
     sim = _simulation(req, rig, programs, script, options, {}, fast_forward="quiet")
     hazards = interactive.run(sim, box, speed=req.speed, hold=script.held)
     return _hazards_ok(req, hazards)
+
+
+def _web(req: Request, rig: Rig, programs: dict, script: Script, options: Options) -> bool:
+    """The box and the stage in the browser (mercmac.web) until Ctrl-C (exit 130)."""
+    from mercmac.web.live import SPEEDS, Live
+    from mercmac.web.server import WebServer
+
+    for given, option in ((req.buttons, "--buttons"), (req.scenario, "--scenario"),
+                          (req.plot, "--plot"), (req.vcd, "--vcd"), (req.interactive,
+                                                                     "--interactive")):
+        if given:
+            raise UsageError(f"{option} does not go with --web: the page is the box (its "
+                             "\"save as scenario\" keeps what you pressed)")
+    if not SPEEDS[0] <= req.speed <= SPEEDS[1]:
+        raise UsageError(f"--speed {req.speed:g}: with --web, from {SPEEDS[0]:g} to "
+                         f"{SPEEDS[1]:g} (the page also runs as fast as it goes)")
+    sim = _simulation(req, rig, programs, script, options, {}, fast_forward="quiet")
+    try:
+        server = WebServer(Live(sim, os.path.basename(req.file), speed=req.speed), req.port)
+    except OSError as e:
+        raise UsageError(f"--port {req.port}: cannot listen on 127.0.0.1: "
+                         f"{e.strerror or e}") from None
+    say(f"the box in the browser: {server.url}")
+    say("Ctrl-C stops it" + ("" if _opened(server.url, req.open_page) else
+                             "; open the address above in a browser"))
+    try:
+        server.serve_forever()  # Ctrl-C: KeyboardInterrupt, exit 130 (cli/common.py)
+    finally:
+        server.server_close()
+    return True
+
+
+def _opened(url: str, wanted: bool) -> bool:
+    """Whether the default browser was asked to open `url`: not where there is no screen to
+    show it on (a console browser would take over this terminal)."""
+    import webbrowser
+
+    if not wanted or (sys.platform.startswith("linux") and not (
+            os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))):
+        return False
+    try:
+        return webbrowser.open(url, new=2)
+    except webbrowser.Error:
+        return False
 
 
 def _box_of(rig: Rig) -> str:

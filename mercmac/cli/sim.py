@@ -40,8 +40,16 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
               help="A live pushbutton box: keys 1-4, r resets (power-on), q quits with a summary.")
 @click.option("--hold", default="", metavar="B[+B]",
               help="With --interactive: inputs held at power-on, e.g. 2 or 2+3 (mode selection).")
+@click.option("--web", is_flag=True,
+              help="The box and the stage in the browser: a local page (127.0.0.1, with a "
+                   "token in its address) where buttons are held with the mouse, touch or "
+                   "keys 1-4; Ctrl-C stops it.")
+@click.option("--port", type=click.IntRange(0, 65535), default=0, metavar="N",
+              help="With --web: the port (default: a free one).")
+@click.option("--no-open", "no_open", is_flag=True,
+              help="With --web: print the address, open no browser.")
 @click.option("--speed", type=FiniteFloat(), default=1.0, show_default=True,
-              help="Simulated seconds per wall-clock second in --interactive.")
+              help="Simulated seconds per wall-clock second in --interactive and --web.")
 @click.option("--scenario", type=click.Path(dir_okay=False), metavar="FILE.toml",
               callback=file_name,
               help="Timed button steps and expectations; exit 1 on the first that fails. "
@@ -61,8 +69,9 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
               help="Position of the reference switch that FE searches for.")
 @click.option("--hard-limits", default=None, metavar="NEG,POS",
               help="Positions of the limit switches, e.g. -200000,200000 (default: none).")
-def sim(file, buttons, joystick, until, fmt, verbose, trace, vcd, vcd_limit, plot, interactive, hold, speed, scenario,
-        fail_on_hazard, allow, target, cycle, servo_off, reference_at, hard_limits) -> None:
+def sim(file, buttons, joystick, until, fmt, verbose, trace, vcd, vcd_limit, plot, interactive, hold,
+        web, port, no_open, speed, scenario, fail_on_hazard, allow, target, cycle, servo_off,
+        reference_at, hard_limits) -> None:
     """Simulate FILE on a virtual controller with a scripted pushbutton box; a rig file
     (*.rig.toml) runs every controller on one clock (--buttons NAME:B@T1-T2).
 
@@ -78,7 +87,8 @@ def sim(file, buttons, joystick, until, fmt, verbose, trace, vcd, vcd_limit, plo
             interactive=interactive, speed=speed, scenario=scenario, target=target,
             cycle_ms=cycle, servo_off=servo_off, reference_at=reference_at,
             hard_limits=hard_limits, fail_on_hazard=fail_on_hazard, hold=hold,
-            verbose=verbose, joystick=joystick, allow_hazard=allow)
+            verbose=verbose, joystick=joystick, allow_hazard=allow, web=web, port=port,
+            open_page=not no_open)
         return EXIT_OK if run.run(request) else EXIT_FAILED
 
     run_guarded(work)

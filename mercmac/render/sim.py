@@ -58,6 +58,12 @@ def _where(where: ev.Where | None) -> str:
     return f"  [{where.label}, line {where.line}]" if where.line else f"  [{where.label}]"
 
 
+# What a live session shows as it happens (`sim --interactive`, `sim --web`): a person's
+# presses, the LEDs, reports, hazards, moves and the program's end.
+LIVE_EVENTS = (ev.InputChanged, ev.JoystickMoved, ev.OutputsChanged, ev.Reported,
+               ev.HazardFound, ev.MoveStarted, ev.MoveEnded, ev.HomeDefined, ev.ProgramEnded)
+
+
 def event_line(event, unit: str = "counts") -> Line | None:
     """One timeline entry as a styled line; None for what the timeline does not show.
     `unit`: what the controller's distances count in (commands.unit: steps on a C-663)."""

@@ -402,3 +402,29 @@ def next_change_ms(sim: Simulation) -> float:
         if m.moving():
             t = min(t, m.now_ms + 1)
     return t if t > now else now + min(m.cycle_ms for m in sim.machines.values())
+
+
+def text(source: str, until_ms: int, changes: list[tuple[int, str, int, bool]],
+         final: dict[str, tuple[int, int, int | None]], *, lone: bool) -> str:
+    """A scenario file of button changes (at_ms, controller, button, down) that expects, at
+    until_ms, each controller's final (position, outputs, macro): what `sim --web` saves.
+    A lone program's steps and expectations name no controller."""
+    def named(controller: str) -> list[str]:
+        return [] if lone else [f"controller = {json.dumps(controller)}"]
+
+    out = ["# A session of the live box (`mercmac sim --web`) from its last power-on: the",
+           "# buttons pressed and released, and what each controller showed at its end.",
+           f"#   mercmac sim {source} --scenario THIS_FILE",
+           f'until = "{until_ms}ms"']
+    steps: dict[tuple[int, str], dict[bool, list[int]]] = {}
+    for at_ms, controller, button, down in changes:
+        steps.setdefault((at_ms, controller), {True: [], False: []})[down].append(button)
+    for (at_ms, controller), moved in steps.items():
+        out += ["", "[[step]]", f'at = "{at_ms}ms"', *named(controller)]
+        out += [f"{key} = {sorted(set(moved[down]))}" for key, down in
+                (("press", True), ("release", False)) if moved[down]]
+    for controller, (position, outputs, macro) in final.items():
+        out += ["", "[[expect]]", f'at = "{until_ms}ms"', *named(controller),
+                f"position = {position}", f"outputs = {outputs}",
+                f"macro = {macro if macro is not None else json.dumps('none')}"]
+    return "\n".join(out) + "\n"

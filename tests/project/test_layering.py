@@ -24,12 +24,12 @@ FOUNDATION = {"mercmac", "mercmac.__version__", "mercmac.commands", "mercmac.dia
 
 # layer -> the layers it must never import
 FORBIDDEN = {
-    "mercmac.vm": {"cli", "render", "sim", "upload", "emulator"},  # the core: no I/O, no text
-    "mercmac.compiler": {"vm", "upload", "emulator", "sim", "cli", "render"},
-    "mercmac.upload": {"cli", "sim", "render", "emulator", "vm"},  # plan and wire, no drawing
-    "mercmac.sim": {"cli", "upload", "emulator", "render"},  # render reads sim, never the reverse
-    "mercmac.emulator": {"cli", "sim", "render"},
-    "mercmac.render": {"cli"},
+    "mercmac.vm": {"cli", "render", "sim", "upload", "emulator", "web"},  # no I/O, no text
+    "mercmac.compiler": {"vm", "upload", "emulator", "sim", "cli", "render", "web"},
+    "mercmac.upload": {"cli", "sim", "render", "emulator", "vm", "web"},  # plan and wire
+    "mercmac.sim": {"cli", "upload", "emulator", "render", "web"},  # render reads sim
+    "mercmac.emulator": {"cli", "sim", "render", "web"},
+    "mercmac.render": {"cli", "web"},
     "mercmac.fmt": {"vm", "upload", "emulator", "sim", "cli", "render"},  # reads the compiler's tokens
     # what a rig is, read and checked: data and the compiler's checks, never what runs it
     "mercmac.rig": {"vm", "sim", "upload", "emulator", "cli", "render", "lsp", "decompile",
@@ -39,6 +39,8 @@ FORBIDDEN = {
     "mercmac.decompile": {"cli", "upload", "emulator", "sim"},
     # the editor's view of `check`: compiler, fmt, rigs and help texts; nothing that runs
     "mercmac.lsp": {"cli", "upload", "emulator", "sim", "vm", "decompile"},
+    # the box in the browser: an application of the simulator beside the CLI, never a port
+    "mercmac.web": {"cli", "upload", "emulator", "lsp", "decompile", "fmt"},
 }
 
 

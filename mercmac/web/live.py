@@ -1,0 +1,191 @@
+"""A simulation run against the wall clock for the page of `sim --web`: the buttons the page
+presses, the state it draws, and the session kept as a scenario.
+
+Every press goes through the machine's input schedule at a whole millisecond just ahead of
+the simulated clock, the way `--buttons` and `--scenario` presses go (sim/simulate.py
+`schedule`), so that the session saved as a scenario replays to the same state on the
+command line. Time runs at `speed` simulated seconds per wall second, or as fast as the
+machine goes (`speed` None), in slices that stop at a wall-clock deadline so that the page
+is answered on time. One lock guards the simulation: the HTTP server's threads share it.
+"""
+from __future__ import annotations
+
+import math
+import threading
+import time
+from dataclasses import dataclass
+
+from mercmac.commands import unit
+from mercmac.render import sim as render
+from mercmac.sim.simulate import Simulation
+
+SLICE_MS = 100  # simulated time run between two looks at the wall clock
+SPEEDS = (0.1, 100.0)  # the slowest and fastest real-time factors the page offers
+LOG = 2000  # timeline lines kept for a page that connects late
+BUTTONS = range(1, 5)  # the C-170.PB's four buttons on inputs 1-4 (MS176E §4.5.1)
+
+
+@dataclass(frozen=True, slots=True)
+class Change:
+    """A button pressed (`down`) or released on a controller at a whole millisecond after
+    the last power-on."""
+
+    at_ms: int
+    controller: str
+    button: int
+    down: bool
+
+
+class Live:
+    """The simulation of one program or rig, its clock tied to the wall clock."""
+
+    def __init__(self, sim: Simulation, file: str, *, speed: float | None = 1.0):
+        self.sim, self.file = sim, file
+        self.lock = threading.Lock()
+        self.speed: float | None = speed
+        self.paused = False
+        self.changes: list[Change] = []  # since the last power-on
+        self.lines: list[str] = []  # the timeline so far (the last LOG lines)
+        self.dropped = 0  # lines before self.lines[0]
+        self.power_ms = 0  # simulated time of the last power-on
+        for name, machine in sim.machines.items():
+            machine.listeners.append(self._listener(name, unit(machine.model)))
+        self._anchor_wall, self._anchor_ms = time.monotonic(), 0.0
+        sim.power_on()
+
+    def _listener(self, name: str, unit_: str):
+        several = len(self.sim.machines) > 1
+
+        def heard(event) -> None:
+            if isinstance(event, render.LIVE_EVENTS):
+                line = render.event_line(event, unit_)
+                if line is not None:
+                    text = "".join(part for part, _ in line)
+                    self.lines.append(f"{name}  {text}" if several else text)
+        return heard
+
+    # ------------------------------------------------------------ the clock
+    def advance(self, budget_s: float = 0.02) -> None:
+        """Run to where the wall clock says simulated time is, at most `budget_s` of work."""
+        with self.lock:
+            if self.paused:
+                return
+            deadline = time.monotonic() + budget_s
+            if self.speed is None:  # as fast as it goes: whatever the budget allows
+                while time.monotonic() < deadline:
+                    self.sim.run_until(self.sim.now_ms() + SLICE_MS)
+                return
+            goal = self._anchor_ms + (time.monotonic() - self._anchor_wall) * 1000 * self.speed
+            while self.sim.now_ms() < goal and time.monotonic() < deadline:
+                self.sim.run_until(min(goal, self.sim.now_ms() + SLICE_MS))
+            if self.sim.now_ms() < goal:  # behind: the wall clock waits for the simulation
+                self._rebase()
+            self._trim()
+
+    def _rebase(self) -> None:
+        self._anchor_wall, self._anchor_ms = time.monotonic(), self.sim.now_ms()
+
+    def _trim(self) -> None:
+        if len(self.lines) > LOG:
+            cut = len(self.lines) - LOG
+            del self.lines[:cut]
+            self.dropped += cut
+
+    def set_speed(self, speed: float | None) -> None:
+        """Real-time factor `speed` (SPEEDS), or None: as fast as it goes."""
+        if speed is not None and not (SPEEDS[0] <= speed <= SPEEDS[1]):  # refuses nan too
+            raise ValueError(f"speed {speed!r}: from {SPEEDS[0]:g} to {SPEEDS[1]:g}, or null "
+                             "for as fast as it goes")
+        with self.lock:
+            self.speed = speed
+            self._rebase()
+
+    def set_paused(self, paused: bool) -> None:
+        with self.lock:
+            self.paused = paused
+            self._rebase()
+
+    # ------------------------------------------------------------ what a person does
+    def press(self, controller: str, button: int, down: bool) -> None:
+        """Button `button` of the box on `controller` down or up, at the next whole ms; a
+        button the box cannot press there (a wire drives that input) is refused."""
+        from mercmac.rig.presses import refusal
+
+        if controller not in self.sim.machines or button not in BUTTONS:
+            raise ValueError(f"no button {button!r} on a controller {controller!r}")
+        why = refusal(self.sim.rig, controller, button)
+        if why is not None:
+            raise ValueError(why)
+        with self.lock:
+            at = math.floor(self.sim.now_ms()) + 1
+            self.sim.machines[controller].schedule_input(at, button, down)
+            self.changes.append(Change(at - self.power_ms, controller, button, down))
+
+    def power_cycle(self) -> None:
+        """Power-on of the whole rig now: macro 0 runs again; held buttons stay held, and
+        the scenario starts here (with them pressed at 0 ms)."""
+        with self.lock:
+            self.sim.run_until(math.ceil(self.sim.now_ms()))
+            self.power_ms = round(self.sim.now_ms())
+            held = [Change(0, name, n, True) for name, m in self.sim.machines.items()
+                    for n in BUTTONS if m.input(n) and self._pressable(name, n)]
+            self.changes = held
+            self.sim.power_on()
+            self.lines.append(f"{render.clock(self.sim.now_ms() * 1000)}  power cycle: "
+                              "macro 0 runs again")
+
+    def _pressable(self, controller: str, button: int) -> bool:
+        from mercmac.rig.presses import refusal
+
+        return refusal(self.sim.rig, controller, button) is None
+
+    def set_joystick(self, controller: str, deflection: float) -> None:
+        """The joystick branch that goes to `controller` held at `deflection` (-1..1)."""
+        if controller not in self.sim.rig.joystick.values():
+            raise ValueError(f"no joystick branch goes to {controller!r}")
+        if not -1 <= deflection <= 1:
+            raise ValueError(f"deflection {deflection!r}: from -1 to 1")
+        with self.lock:
+            self.sim.machines[controller].set_joystick(deflection)
+
+    # ------------------------------------------------------------ what the page shows
+    def state(self, seen_lines: int) -> tuple[dict, int]:
+        """The state the page draws, with the timeline lines after the first `seen_lines`
+        (counted from the start of the session); and the count of lines seen then."""
+        with self.lock:
+            new = self.lines[max(0, seen_lines - self.dropped):]
+            sticks = set(self.sim.rig.joystick.values())
+            return {"t_ms": round(self.sim.now_ms(), 3), "paused": self.paused,
+                    "speed": self.speed, "file": self.file,
+                    "controllers": [self._controller(name, m, name in sticks)
+                                    for name, m in self.sim.machines.items()],
+                    "wires": [{"from": str(w.source), "to": str(w.target),
+                               "high": self.sim.machines[w.source.controller].outputs_pattern()
+                               >> (w.source.number - 1) & 1 == 1} for w in self.sim.rig.wires],
+                    "lines": new}, self.dropped + len(self.lines)
+
+    def _controller(self, name: str, m, stick: bool) -> dict:
+        low, high = m.axis.soft_range()
+        lines = m.input_lines()
+        return {"name": name, "model": m.model, "unit": unit(m.model),
+                "leds": [m.outputs_pattern() >> i & 1 == 1 for i in range(4)],
+                "buttons": [bool(lines[n]) for n in BUTTONS],
+                "pressable": [self._pressable(name, n) for n in BUTTONS],
+                "position": m.position(), "target": m.target,
+                "macro": m.label or "direct mode", "soft_limits": [low, high],
+                "joystick": (m.deflection or 0.0) if stick else None}
+
+    # ------------------------------------------------------------ the session as a test
+    def scenario(self) -> str:
+        """The presses since the last power-on as a `sim --scenario` file, expecting what
+        each controller shows now: its position, LEDs and macro (docs/simulator.md)."""
+        from mercmac.sim.scenario import text
+
+        with self.lock:
+            end = math.floor(self.sim.now_ms())
+            steps = [(c.at_ms, c.controller, c.button, c.down) for c in self.changes
+                     if c.at_ms + self.power_ms <= end]
+            expect = {name: (m.position(), m.outputs_pattern(), m.macro)
+                      for name, m in self.sim.machines.items()}
+            lone = self.sim.rig.lone
+        return text(self.file, end - self.power_ms, steps, expect, lone=lone)
