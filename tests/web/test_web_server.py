@@ -15,46 +15,17 @@ import re
 import signal
 import subprocess
 import sys
-import threading
 import time
 import urllib.error
 import urllib.request
-from pathlib import Path
-
-import pytest
 
 from helpers.paths import EXAMPLE4, FOUR_MODES, ROOT
-from mercmac.rig.open import open_program, open_rig
-from mercmac.sim.simulate import Simulation
-from mercmac.web.live import Live
 from mercmac.web.server import CSP, WebServer
 
 WAIT_S = 30.0
 RASTER_RIG = ROOT / "examples" / "rigs" / "raster" / "raster.rig.toml"
 
 
-def _simulation(path: Path) -> Simulation:
-    opened = (open_rig(str(path)).accepted() if path.name.endswith(".rig.toml")
-              else open_program(str(path)))
-    return Simulation(opened.rig, {n: c.program for n, c in opened.programs.items()},
-                      fast_forward="quiet")
-
-
-@pytest.fixture
-def serve():
-    """serve(path, speed) -> a running WebServer for the file; stopped after the test."""
-    running = []
-
-    def start(path: Path, speed: float | None = 1.0) -> WebServer:
-        server = WebServer(Live(_simulation(path), path.name, speed=speed))
-        threading.Thread(target=server.serve_forever, daemon=True).start()
-        running.append(server)
-        return server
-
-    yield start
-    for server in running:
-        server.shutdown()
-        server.server_close()
 
 
 def _get(server: WebServer, path: str, *, token: bool = True, host: str | None = None):

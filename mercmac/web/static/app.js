@@ -192,6 +192,7 @@
       controllersEl.append(card.root);
     }
     if (!cards.has(activeName)) activeName = null;
+    for (const name of cards.keys()) for (const n of BUTTONS) showHeld(name, n);
     controllersEl.classList.toggle("several", several);
   }
 
@@ -213,7 +214,8 @@
     }
     const box = el("div", {class: "box"},
       el("div", {class: "box-head"}, el("span", {class: "box-model", text: "C-170.PB"}),
-        el("span", {class: "keys-hint", text: "keys 1–4", title: "keys 1-4 press these buttons"})),
+        el("span", {class: "keys-hint", text: "keys 1–4", title: "keys 1-4 press these buttons"}),
+        el("span", {class: "no-box-hint", text: "no box here", title: "the box is plugged into another controller, or wires drive these inputs"})),
       grid);
 
     // the stage: a rail over the travel range, soft limits, the target and the carriage
@@ -271,11 +273,22 @@
     root.addEventListener("pointerdown", () => { if (hasPressable(name)) activeName = name; ask(); });
     root.addEventListener("focusin", () => { if (hasPressable(name)) activeName = name; ask(); });
 
-    Object.assign(parts, {root, bar, zoneLo, zoneHi, softLo, softHi, target, carriage, tmin, tmax,
+    Object.assign(parts, {root, bar, rail, zoneLo, zoneHi, softLo, softHi, target, carriage, tmin, tmax,
       pos, posUnit, tgt, tgtUnit, macro, plot, line, plotTarget, plotSoftLo, plotSoftHi, joyRow,
       plotMax: plotWrap.querySelector(".plot-max"), plotMin: plotWrap.querySelector(".plot-min"),
       model: head.querySelector(".card-model"), softText: travel.querySelector(".travel-soft"),
-      box});
+      box, barW: BAR_W, noBox: box.querySelector(".no-box-hint")});
+    // the bar is drawn in its own pixels, so that the carriage and the marks keep their shape
+    if (window.ResizeObserver) {
+      new ResizeObserver((entries) => {
+        const w = Math.round(entries[0].contentRect.width);
+        if (w > 0 && w !== parts.barW) {
+          parts.barW = w;
+          bar.setAttribute("viewBox", `0 0 ${w} ${BAR_H}`);
+          ask();
+        }
+      }).observe(bar);
+    }
     return parts;
   }
 
@@ -351,18 +364,22 @@
   }
   function latchOn() { return $("latch").checked; }
 
+  function toggleLatch(name, n) {
+    if (held.get(key(name, n))?.has("latch")) release(name, n, "latch");
+    else hold(name, n, "latch");
+  }
+
   function wireButton(b, name, n) {
     let pid = null;
     b.addEventListener("pointerdown", (e) => {
       if (e.pointerType === "mouse" && e.button !== 0) return;
       if (!canPress(name, n)) return;
-      if (latchOn()) return;  // the click toggles
-      e.preventDefault();     // no text selection, no focus stealing by a touch
-      b.focus({preventScroll: true});
+      e.preventDefault();     // no text selection, no focus ring, no scrolling by a touch
+      if (latchOn()) { toggleLatch(name, n); return; }  // at once, as the pointer goes down
       pid = e.pointerId;
       try { b.setPointerCapture(pid); } catch (err) { /* not capturable: pointerleave ends it */ }
-      release(name, n, "latch");  // a press without latch lets go of a latched button after
       hold(name, n, "pointer");
+      release(name, n, "latch");  // a press without latch lets go of a latched button after
     });
     const end = (e) => {
       if (pid === null || e.pointerId !== pid) return;
@@ -375,12 +392,10 @@
     b.addEventListener("lostpointercapture", end);
     b.addEventListener("contextmenu", (e) => e.preventDefault());
     b.addEventListener("click", (e) => {
-      if (!canPress(name, n)) return;
-      if (latchOn()) {
-        if (held.get(key(name, n))?.has("latch")) release(name, n, "latch");
-        else hold(name, n, "latch");
-      } else if (e.detail === 0 && !isHeld(name, n)) {
-        // Enter or Space on the focused button: a short press
+      if (!canPress(name, n) || e.detail !== 0) return;  // a pointer's click: done at pointerdown
+      // Enter or Space on the focused button
+      if (latchOn()) toggleLatch(name, n);
+      else if (!isHeld(name, n)) {  // a short press
         hold(name, n, "click");
         setTimeout(() => release(name, n, "click"), 150);
       }
@@ -542,9 +557,14 @@
     let [lo, hi] = Array.isArray(c.travel) && c.travel.length === 2 ? c.travel.map(Number) : [NaN, NaN];
     const p = Number(c.position), tg = Number(c.target);
     if (!Number.isFinite(lo) || !Number.isFinite(hi) || hi <= lo) {
-      lo = Math.min(p, tg, 0); hi = Math.max(p, tg, 1);
+      // no travel given: the range seen so far, which only grows, so the bar stays still
+      const r = k.seen || (k.seen = [Infinity, -Infinity]);
+      for (const v of [p, tg]) if (Number.isFinite(v)) { r[0] = Math.min(r[0], v); r[1] = Math.max(r[1], v); }
+      if (!(r[1] > r[0])) { lo = (Number.isFinite(r[0]) ? r[0] : 0) - 1000; hi = lo + 2000; } else {
+        const m = (r[1] - r[0]) * 0.05; lo = r[0] - m; hi = r[1] + m;
+      }
     }
-    const pad = 20, span = BAR_W - 2 * pad;
+    const W = k.barW, pad = 16, span = W - 2 * pad;
     const X = (v) => pad + Math.max(-0.02, Math.min(1.02, (v - lo) / (hi - lo))) * span;
     setAttr(k.rail, "x", pad); setAttr(k.rail, "width", span);
     setAttr(k.carriage, "x", (X(p) - 14).toFixed(1));
@@ -556,17 +576,18 @@
     const sl = Array.isArray(c.soft_limits) ? c.soft_limits : [null, null];
     const sLo = sl[0] === null || sl[0] === undefined ? null : Number(sl[0]);
     const sHi = sl[1] === null || sl[1] === undefined ? null : Number(sl[1]);
-    if (sLo !== null) {
+    const inside = (v) => v !== null && Number.isFinite(v) && v >= lo && v <= hi;
+    if (inside(sLo)) {
       const x = X(sLo);
       setAttr(k.softLo, "x1", x.toFixed(1)); setAttr(k.softLo, "x2", x.toFixed(1));
       setAttr(k.softLo, "visibility", "visible");
       setAttr(k.zoneLo, "x", pad); setAttr(k.zoneLo, "width", Math.max(0, x - pad).toFixed(1));
     } else { setAttr(k.softLo, "visibility", "hidden"); setAttr(k.zoneLo, "width", 0); }
-    if (sHi !== null) {
+    if (inside(sHi)) {
       const x = X(sHi);
       setAttr(k.softHi, "x1", x.toFixed(1)); setAttr(k.softHi, "x2", x.toFixed(1));
       setAttr(k.softHi, "visibility", "visible");
-      setAttr(k.zoneHi, "x", x.toFixed(1)); setAttr(k.zoneHi, "width", Math.max(0, BAR_W - pad - x).toFixed(1));
+      setAttr(k.zoneHi, "x", x.toFixed(1)); setAttr(k.zoneHi, "width", Math.max(0, W - pad - x).toFixed(1));
     } else { setAttr(k.softHi, "visibility", "hidden"); setAttr(k.zoneHi, "width", 0); }
     setText(k.tmin, fmt(lo));
     setText(k.tmax, fmt(hi));
@@ -655,11 +676,7 @@
         const state = el("span", {class: "wire-state"});
         const li = el("li", {class: "wire", "data-high": "false"},
           el("span", {class: "wire-end", text: w.from}),
-          (function () {
-            const s = sv("svg", {class: "wire-line", viewBox: "0 0 100 12", preserveAspectRatio: "none", "aria-hidden": "true"});
-            s.append(sv("line", {x1: 2, x2: 92, y1: 6, y2: 6}), sv("path", {d: "M90 1 L99 6 L90 11 Z"}));
-            return s;
-          })(),
+          el("span", {class: "wire-line", "aria-hidden": "true"}),
           el("span", {class: "wire-end", text: w.to}),
           state);
         li._state = state;
@@ -728,11 +745,14 @@
 
   function renderProblems() {
     if (pendingProblems === undefined) return;
-    const list = pendingProblems;
+    const list = pendingProblems.map(String);
     pendingProblems = undefined;
+    const sig = JSON.stringify(list);
+    if (sig === renderProblems.last) return;
+    renderProblems.last = sig;
     const box = $("problems"), ul = $("problems-list");
     ul.textContent = "";
-    for (const p of list) ul.append(el("li", {text: String(p)}));
+    for (const p of list) ul.append(el("li", {text: p}));
     box.hidden = list.length === 0;
   }
 
