@@ -75,7 +75,10 @@ class Live:
                 while time.monotonic() < deadline:
                     self.sim.run_until(self.sim.now_ms() + SLICE_MS)
                 return
-            goal = self._anchor_ms + (time.monotonic() - self._anchor_wall) * 1000 * self.speed
+            # whole milliseconds only: a press is scheduled at one, and a saved scenario
+            # expects what the controllers show at one
+            goal = math.floor(self._anchor_ms
+                              + (time.monotonic() - self._anchor_wall) * 1000 * self.speed)
             while self.sim.now_ms() < goal and time.monotonic() < deadline:
                 self.sim.run_until(min(goal, self.sim.now_ms() + SLICE_MS))
             if self.sim.now_ms() < goal:  # behind: the wall clock waits for the simulation
@@ -182,7 +185,8 @@ class Live:
         from mercmac.sim.scenario import text
 
         with self.lock:
-            end = math.floor(self.sim.now_ms())
+            self.sim.run_until(math.ceil(self.sim.now_ms()))  # the state at a whole ms
+            end = round(self.sim.now_ms())
             steps = [(c.at_ms, c.controller, c.button, c.down) for c in self.changes
                      if c.at_ms + self.power_ms <= end]
             expect = {name: (m.position(), m.outputs_pattern(), m.macro)

@@ -11,6 +11,7 @@ chromium`, which the fixture runs when it may).
 """
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -22,6 +23,7 @@ from helpers.locking import held, lock_file
 from helpers.paths import EXAMPLE4, ROOT
 
 sync_api = pytest.importorskip("playwright.sync_api", reason="the test extra installs playwright")
+sync_api.expect.set_options(timeout=30_000)  # a busy machine: the suite's other workers
 RASTER_RIG = ROOT / "examples" / "rigs" / "raster" / "raster.rig.toml"
 WAIT_MS = 30_000
 # chromium on a machine without a network: no calls home (see the e2e script of the editor)
@@ -69,6 +71,9 @@ class Watched:
         self.page.on("pageerror", lambda e: self.errors.append(str(e)))
         self.page.set_default_timeout(WAIT_MS)
         self.page.goto(server.url)
+        # the cards are drawn from the first state: a key pressed before would go nowhere
+        self.page.locator("#conn[data-state=open]").wait_for()
+        self.page.get_by_role("button", name=re.compile(r"button 1$")).first.wait_for()
 
     def named(self, name: str):
         return self.page.get_by_label(name, exact=True)

@@ -149,3 +149,24 @@ def test_the_command_prints_its_address_and_stops_on_ctrl_c():
         process.kill()
         process.wait()
     assert "Traceback" not in process.stderr.read()
+
+
+def test_a_scenario_is_saved_at_a_whole_millisecond(tmp_path):
+    """Motion goes on within a millisecond: a scenario saved while the clock stood between two
+    expected a position the replay never has at a whole one."""
+    from helpers.web import simulation
+    from mercmac.web.live import Live
+
+    live = Live(simulation(EXAMPLE4), EXAMPLE4.name)
+    name = next(iter(live.sim.machines))
+    live.press(name, 3, True)
+    live.sim.run_until(20)
+    live.power_cycle()
+    live.sim.run_until(live.sim.now_ms() + 250.5)  # inside the first move of mode 3
+    scenario = tmp_path / "between.toml"
+    scenario.write_text(live.scenario(), encoding="utf-8")
+    assert live.sim.now_ms() == round(live.sim.now_ms())
+    done = subprocess.run([sys.executable, "-m", "mercmac", "sim", str(EXAMPLE4), "--scenario",
+                           str(scenario)], capture_output=True, text=True, timeout=120,
+                          stdin=subprocess.DEVNULL)
+    assert done.returncode == 0, done.stdout[-1500:]
