@@ -112,10 +112,10 @@ def _run(req: Request) -> bool:
         return False
     rig = accepted.rig
     programs = {name: c.program for name, c in accepted.programs.items()}
+    if req.web:  # first: it refuses the options of the other ways to run
+        return _web(req, rig, programs, script, options)
     if req.interactive:
         return _interactive(req, rig, programs, script, options)
-    if req.web:
-        return _web(req, rig, programs, script, options)
     if req.scenario:
         return _scenario(req, rig, programs, script, options)
     until = _until(req.until, None)

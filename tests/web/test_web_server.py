@@ -170,3 +170,12 @@ def test_a_scenario_is_saved_at_a_whole_millisecond(tmp_path):
                            str(scenario)], capture_output=True, text=True, timeout=120,
                           stdin=subprocess.DEVNULL)
     assert done.returncode == 0, done.stdout[-1500:]
+
+
+def test_options_the_page_replaces_are_refused_with_web():
+    for option in (["--buttons", "1@0-1s"], ["--interactive"], ["--speed", "1000"]):
+        done = subprocess.run([sys.executable, "-m", "mercmac", "sim", str(FOUR_MODES), "--web",
+                               "--no-open", *option], capture_output=True, text=True,
+                              timeout=60, stdin=subprocess.DEVNULL)
+        assert done.returncode == 2, (option, done.stderr)
+        assert "--web" in done.stderr and "Traceback" not in done.stderr, done.stderr
