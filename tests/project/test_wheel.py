@@ -182,6 +182,10 @@ def test_the_wheel_holds_the_examples_and_the_sdist_the_tests(released):
     from mercmac import bundled
 
     assert held == set(bundled.texts()) and "rigs/raster/raster.rig.toml" in held
+    # the page of `sim --web`: every asset ships in the package, none comes from the network
+    static = {n for n in zipfile.ZipFile(wheel).namelist() if n.startswith("mercmac/web/static/")}
+    assert static == {f"mercmac/web/static/{name}" for name in ("index.html", "app.js",
+                                                                "style.css")}
     (sdist,) = released.glob("*.tar.gz")
     names = {n.split("/", 1)[1] for n in tarfile.open(sdist).getnames() if "/" in n}
     assert {"README.md", "LICENSE", "mercmac/grammar.lark", "examples/rigs/raster/x.mcm",
