@@ -114,6 +114,8 @@ def _run(req: Request) -> bool:
     programs = {name: c.program for name, c in accepted.programs.items()}
     if req.web:  # first: it refuses the options of the other ways to run
         return _web(req, rig, programs, script, options)
+    if req.port or not req.open_page:
+        raise UsageError(f"{'--port' if req.port else '--no-open'} is for --web")
     if req.interactive:
         return _interactive(req, rig, programs, script, options)
     if req.scenario:
@@ -181,11 +183,11 @@ def _hazards_ok(req: Request, hazards: int) -> bool:
 
 
 def _hold(req: Request) -> tuple[int, ...]:
-    """--hold: the inputs held at power-on, only for --interactive."""
+    """--hold: the inputs held at power-on, only for a live box (--interactive, --web)."""
     if not req.hold:
         return ()
-    if not req.interactive:
-        raise UsageError("--hold is for --interactive; in a script, press at 0: "
+    if not (req.interactive or req.web):
+        raise UsageError("--hold is for --interactive and --web; in a script, press at 0: "
                          f"--buttons \"{req.hold.strip()}@0-500ms\"")
     try:
         (press,) = parse_buttons(f"{req.hold}@0")
@@ -328,18 +330,25 @@ def _web(req: Request, rig: Rig, programs: dict, script: Script, options: Option
     from mercmac.web.live import SPEEDS, Live
     from mercmac.web.server import WebServer
 
-    for given, option in ((req.buttons, "--buttons"), (req.scenario, "--scenario"),
-                          (req.plot, "--plot"), (req.vcd, "--vcd"), (req.interactive,
-                                                                     "--interactive")):
+    # what the page does itself, or what a session without an end has no use for: refused,
+    # not ignored (a joystick held by the command line would not be in a saved scenario)
+    for given, option in ((req.buttons, "--buttons"), (req.joystick, "--joystick"),
+                          (req.scenario, "--scenario"), (req.until, "--until"),
+                          (req.plot, "--plot"), (req.vcd, "--vcd"), (req.trace, "--trace"),
+                          (req.fmt != "text", "--format"), (req.verbose, "-v"),
+                          (req.fail_on_hazard, "--fail-on-hazard"),
+                          (req.interactive, "--interactive")):
         if given:
-            raise UsageError(f"{option} does not go with --web: the page is the box (its "
-                             "\"save as scenario\" keeps what you pressed)")
+            raise UsageError(f"{option} does not go with --web: the page is the box, and its "
+                             "\"save as scenario\" keeps what you pressed")
     if not SPEEDS[0] <= req.speed <= SPEEDS[1]:
         raise UsageError(f"--speed {req.speed:g}: with --web, from {SPEEDS[0]:g} to "
                          f"{SPEEDS[1]:g} (the page also runs as fast as it goes)")
     sim = _simulation(req, rig, programs, script, options, {}, fast_forward="quiet")
     try:
-        server = WebServer(Live(sim, os.path.basename(req.file), speed=req.speed), req.port)
+        live = Live(sim, os.path.basename(req.file), speed=req.speed,
+                    held={_box_of(rig): script.held} if script.held else {})
+        server = WebServer(live, req.port)
     except OSError as e:
         raise UsageError(f"--port {req.port}: cannot listen on 127.0.0.1: "
                          f"{e.strerror or e}") from None
@@ -370,8 +379,8 @@ def _opened(url: str, wanted: bool) -> bool:
 def _box_of(rig: Rig) -> str:
     """The controller the box is plugged into, which --interactive and --hold press."""
     if rig.box is None:
-        raise UsageError("--interactive needs the rig's box: say which controller holds the "
-                         "C-170.PB with box = \"NAME\" in the rig file")
+        raise UsageError("--interactive and --hold need the rig's box: say which controller "
+                         "holds the C-170.PB with box = \"NAME\" in the rig file")
     return rig.box
 
 

@@ -39,7 +39,8 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
 @click.option("--interactive", is_flag=True,
               help="A live pushbutton box: keys 1-4, r resets (power-on), q quits with a summary.")
 @click.option("--hold", default="", metavar="B[+B]",
-              help="With --interactive: inputs held at power-on, e.g. 2 or 2+3 (mode selection).")
+              help="With --interactive or --web: inputs held at power-on, e.g. 2 or 2+3 (mode "
+                   "selection).")
 @click.option("--web", is_flag=True,
               help="The box and the stage in the browser: a local page (127.0.0.1, with a "
                    "token in its address) where buttons are held with the mouse, touch or "

@@ -14,9 +14,11 @@ import math
 import threading
 import time
 from dataclasses import dataclass
+from typing import Mapping
 
 from mercmac.commands import unit
 from mercmac.render import sim as render
+from mercmac.rig.presses import refusal
 from mercmac.sim.simulate import Simulation
 
 SLICE_MS = 100  # simulated time run between two looks at the wall clock
@@ -39,7 +41,9 @@ class Change:
 class Live:
     """The simulation of one program or rig, its clock tied to the wall clock."""
 
-    def __init__(self, sim: Simulation, file: str, *, speed: float | None = 1.0):
+    def __init__(self, sim: Simulation, file: str, *, speed: float | None = 1.0,
+                 held: Mapping[str, tuple[int, ...]] | None = None):
+        """`held`: the inputs held at power-on, by controller (`--hold`)."""
         self.sim, self.file = sim, file
         self.lock = threading.Lock()
         self.speed: float | None = speed
@@ -51,6 +55,12 @@ class Live:
         for name, machine in sim.machines.items():
             machine.listeners.append(self._listener(name, unit(machine.model)))
         self._anchor_wall, self._anchor_ms = time.monotonic(), 0.0
+        self.pressable = {name: [refusal(sim.rig, name, n) is None for n in BUTTONS]
+                          for name in sim.machines}  # the wires say it, once for the session
+        for name, inputs in (held or {}).items():
+            for n in inputs:
+                sim.machines[name].set_input(n, True)
+                self.changes.append(Change(0, name, n, True))
         sim.power_on()
 
     def _listener(self, name: str, unit_: str):
@@ -112,8 +122,6 @@ class Live:
     def press(self, controller: str, button: int, down: bool) -> None:
         """Button `button` of the box on `controller` down or up, at the next whole ms; a
         button the box cannot press there (a wire drives that input) is refused."""
-        from mercmac.rig.presses import refusal
-
         if controller not in self.sim.machines or button not in BUTTONS:
             raise ValueError(f"no button {button!r} on a controller {controller!r}")
         why = refusal(self.sim.rig, controller, button)
@@ -131,16 +139,11 @@ class Live:
             self.sim.run_until(math.ceil(self.sim.now_ms()))
             self.power_ms = round(self.sim.now_ms())
             held = [Change(0, name, n, True) for name, m in self.sim.machines.items()
-                    for n in BUTTONS if m.input(n) and self._pressable(name, n)]
+                    for n in BUTTONS if m.input(n) and self.pressable[name][n - 1]]
             self.changes = held
             self.sim.power_on()
             self.lines.append(f"{render.clock(self.sim.now_ms() * 1000)}  power cycle: "
                               "macro 0 runs again")
-
-    def _pressable(self, controller: str, button: int) -> bool:
-        from mercmac.rig.presses import refusal
-
-        return refusal(self.sim.rig, controller, button) is None
 
     def set_joystick(self, controller: str, deflection: float) -> None:
         """The joystick branch that goes to `controller` held at `deflection` (-1..1)."""
@@ -173,7 +176,7 @@ class Live:
         return {"name": name, "model": m.model, "unit": unit(m.model),
                 "leds": [m.outputs_pattern() >> i & 1 == 1 for i in range(4)],
                 "buttons": [bool(lines[n]) for n in BUTTONS],
-                "pressable": [self._pressable(name, n) for n in BUTTONS],
+                "pressable": self.pressable[name],
                 "position": m.position(), "target": m.target,
                 "macro": m.label or "direct mode", "soft_limits": [low, high],
                 "joystick": (m.deflection or 0.0) if stick else None}

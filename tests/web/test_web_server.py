@@ -173,9 +173,39 @@ def test_a_scenario_is_saved_at_a_whole_millisecond(tmp_path):
 
 
 def test_options_the_page_replaces_are_refused_with_web():
-    for option in (["--buttons", "1@0-1s"], ["--interactive"], ["--speed", "1000"]):
+    for option in (["--buttons", "1@0-1s"], ["--interactive"], ["--speed", "1000"],
+                   ["--until", "5s"], ["--joystick", "X=1@0-1s"], ["--format", "json"]):
         done = subprocess.run([sys.executable, "-m", "mercmac", "sim", str(FOUR_MODES), "--web",
                                "--no-open", *option], capture_output=True, text=True,
                               timeout=60, stdin=subprocess.DEVNULL)
         assert done.returncode == 2, (option, done.stderr)
         assert "--web" in done.stderr and "Traceback" not in done.stderr, done.stderr
+
+
+def test_web_options_without_web_are_refused():
+    for option in (["--port", "8123"], ["--no-open"]):
+        done = subprocess.run([sys.executable, "-m", "mercmac", "sim", str(FOUR_MODES), *option],
+                              capture_output=True, text=True, timeout=60,
+                              stdin=subprocess.DEVNULL)
+        assert done.returncode == 2 and "is for --web" in done.stderr, (option, done.stderr)
+
+
+def test_hold_chooses_the_mode_at_power_on_and_is_in_the_scenario(tmp_path):
+    """`--hold 3` with --web holds button 3 at power-on, as --interactive does: Example 4's
+    mode 3, and the saved scenario presses it at 0 ms."""
+    from helpers.web import simulation
+    from mercmac.web.live import Live
+
+    sim = simulation(EXAMPLE4)
+    name = next(iter(sim.machines))
+    live = Live(sim, EXAMPLE4.name, held={name: (3,)})
+    live.sim.run_until(600)
+    assert live.sim.machines[name].position() < 0  # mode 3 steps the stage back
+    text = live.scenario()
+    assert re.search(r'at = "0ms"\npress = \[3\]', text), text
+    scenario = tmp_path / "held.toml"
+    scenario.write_text(text, encoding="utf-8")
+    done = subprocess.run([sys.executable, "-m", "mercmac", "sim", str(EXAMPLE4), "--scenario",
+                           str(scenario)], capture_output=True, text=True, timeout=120,
+                          stdin=subprocess.DEVNULL)
+    assert done.returncode == 0, done.stdout[-1500:]
