@@ -28,10 +28,18 @@
   const BAR_W = 1000, BAR_H = 56;  // the stage bar's viewBox
   const XY_MAX = 60000;           // path points kept
 
+  // How the page reaches the simulation: this server over HTTP, or, in VS Code's webview
+  // (which may not reach 127.0.0.1 itself), the extension, which relays to the same server.
+  // The extension's script sets window.mercmacBridge before this one runs:
+  //   post(path, body) -> Promise (rejects with an Error saying why),
+  //   events({open(), message(text), error(closed)}): the event stream's data lines,
+  //   saveScenario() -> Promise of a note to show (the extension asks where to save).
+  const BRIDGE = window.mercmacBridge || null;
+
   // Actions go one after the other, so that a release never overtakes its press.
   let queue = Promise.resolve();
   function post(path, body) {
-    const run = () => fetch(path, {
+    const run = () => BRIDGE ? BRIDGE.post(path, body) : fetch(path, {
       method: "POST",
       headers: {"Content-Type": "application/json", "X-Mercmac-Token": TOKEN},
       body: JSON.stringify(body),
@@ -102,7 +110,24 @@
     conn.dataset.state = state;
     conn.textContent = text;
   }
+  function received(data) {
+    let s;
+    try { s = JSON.parse(data); } catch (e) { return; }
+    if (!s || typeof s !== "object") return;
+    ingest(s);
+    latest = s;
+    ask();
+  }
   function connect() {
+    if (BRIDGE) {
+      BRIDGE.events({
+        open: () => setConn("open", "live"),
+        message: received,
+        error: (closed) => setConn(closed ? "closed" : "connecting",
+          closed ? "disconnected" : "reconnecting"),
+      });
+      return;
+    }
     const es = new EventSource("/api/events?token=" + encodeURIComponent(TOKEN));
     es.onopen = () => setConn("open", "live");
     es.onerror = () => {
@@ -110,14 +135,7 @@
         es.readyState === EventSource.CLOSED ? "disconnected" : "reconnecting");
       if (es.readyState === EventSource.CLOSED) setTimeout(connect, 2000);
     };
-    es.onmessage = (ev) => {
-      let s;
-      try { s = JSON.parse(ev.data); } catch (e) { return; }
-      if (!s || typeof s !== "object") return;
-      ingest(s);
-      latest = s;
-      ask();
-    };
+    es.onmessage = (ev) => received(ev.data);
   }
 
   function ask() {
@@ -480,6 +498,11 @@
   $("power").addEventListener("click", () => { post("/api/power", {}); });
   $("save").addEventListener("click", async () => {
     try {
+      if (BRIDGE) {
+        const said = await BRIDGE.saveScenario();
+        if (said) note(String(said), "note");
+        return;
+      }
       const r = await fetch("/api/scenario?token=" + encodeURIComponent(TOKEN),
         {headers: {"X-Mercmac-Token": TOKEN}});
       if (!r.ok) throw new Error(`scenario: ${r.status} ${(await r.text()).trim()}`);
@@ -757,6 +780,6 @@
   }
 
   // ------------------------------------------------------------------ go
-  if (!TOKEN) setConn("closed", "no token in the address");
+  if (!TOKEN && !BRIDGE) setConn("closed", "no token in the address");
   connect();
 })();
