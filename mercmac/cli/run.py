@@ -113,7 +113,7 @@ def _run(req: Request) -> bool:
     rig = accepted.rig
     programs = {name: c.program for name, c in accepted.programs.items()}
     if req.web:  # first: it refuses the options of the other ways to run
-        return _web(req, rig, programs, script, options)
+        return _web(req, rig, programs, script, options, _read_from(accepted.findings, req))
     if req.port or not req.open_page:
         raise UsageError(f"{'--port' if req.port else '--no-open'} is for --web")
     if req.interactive:
@@ -325,10 +325,13 @@ def _interactive(req: Request, rig: Rig, programs: dict, script: Script,
     return _hazards_ok(req, hazards)
 
 
-def _web(req: Request, rig: Rig, programs: dict, script: Script, options: Options) -> bool:
-    """The box and the stage in the browser (mercmac.web) until Ctrl-C (exit 130)."""
+def _web(req: Request, rig: Rig, programs: dict, script: Script, options: Options,
+         paths: tuple[str, ...]) -> bool:
+    """The box and the stage in the browser (mercmac.web) until Ctrl-C (exit 130), the
+    file (`paths`: with a rig's programs) reopened when it changes on disk."""
     from mercmac.web.live import SPEEDS, Live
     from mercmac.web.server import WebServer
+    from mercmac.web.watch import Watcher
 
     # what the page does itself, or what a session without an end has no use for: refused,
     # not ignored (a joystick held by the command line would not be in a saved scenario)
@@ -352,14 +355,43 @@ def _web(req: Request, rig: Rig, programs: dict, script: Script, options: Option
     except OSError as e:
         raise UsageError(f"--port {req.port}: cannot listen on 127.0.0.1: "
                          f"{e.strerror or e}") from None
+    watcher = Watcher(live, lambda: _reopened(req, options), paths)
     say(f"the box in the browser: {server.url}")
     say("Ctrl-C stops it" + ("" if _opened(server.url, req.open_page) else
                              "; open the address above in a browser"))
+    watcher.start()
     try:
         server.serve_forever()  # Ctrl-C: KeyboardInterrupt, exit 130 (cli/common.py)
     finally:
+        watcher.stop()
         server.server_close()
     return True
+
+
+def _reopened(req: Request, options: Options):
+    """The file opened and checked again after it changed on disk (--web follows saves):
+    its new simulation, or its problems as `check` words them."""
+    from mercmac.errors import MercmacError
+    from mercmac.render.report import finding_texts
+    from mercmac.rig import is_rig_path
+    from mercmac.rig.open import RigRefused, open_rig
+    from mercmac.web.watch import Loaded
+
+    try:
+        accepted = open_rig(req.file).accepted() if is_rig_path(req.file) else _lone(req)()
+    except RigRefused as e:
+        return Loaded(None, finding_texts(e.findings), _read_from(e.findings, req))
+    except MercmacError as e:  # a file that cannot be read now (deleted, half written)
+        return Loaded(None, [str(e)], ())
+    programs = {name: c.program for name, c in accepted.programs.items()}
+    sim = _simulation(req, accepted.rig, programs, Script({}, [], (), []), options, {},
+                      fast_forward="quiet")
+    return Loaded(sim, [], _read_from(accepted.findings, req))
+
+
+def _read_from(findings, req: Request) -> tuple[str, ...]:
+    """The files a rig or a program was read from: the file itself, a rig's programs."""
+    return tuple(dict.fromkeys((req.file, *(f.compilation.source.name for f in findings))))
 
 
 def _opened(url: str, wanted: bool) -> bool:

@@ -18,6 +18,9 @@ from mercmac.ops import USER_ORIGINS, Origin
 # The client command a "build" lens runs with {"macro": name, "lines": [MD lines]}:
 # the VS Code extension copies the lines (docs/editors.md, ## VS Code).
 COPY_BUILD = "mercmac.copyBuild"
+# The client command the "simulate" lens on `autostart` runs with {"uri": the document's}:
+# the VS Code extension opens `sim FILE --web` beside the editor (docs/editors.md, ## VS Code).
+SIMULATE = "mercmac.simulate"
 
 
 class Hint(NamedTuple):
@@ -154,6 +157,18 @@ def lenses(items: tuple, program: Program | None, errors: int = 0) -> list[Lens]
         elif mine:
             out.append(Lens(item.span.line, _title(mine), name, tuple(m.md for m in mine)))
     return out
+
+
+def simulate(items: tuple, errors: int = 0) -> Lens | None:
+    """The "simulate" lens on the autostart block, which the box runs at power-on; with
+    `errors` in the file `sim` refuses it, so the lens says so."""
+    start = next((item for item in items if isinstance(item, ast.Autostart)), None)
+    if start is None:
+        return None
+    if errors:
+        return Lens(start.span.line, f"simulate: not while the file has {errors} "
+                                     f"error{'s' * (errors > 1)}", "autostart", ())
+    return Lens(start.span.line, "▶ simulate: the box and the stage", "autostart", ())
 
 
 def _title(mine: list[Macro]) -> str:

@@ -123,17 +123,25 @@ def inlay_hints(ls: MercmacServer, params: t.InlayHintParams) -> list[t.InlayHin
 @features.on(t.TEXT_DOCUMENT_CODE_LENS, t.CodeLensOptions(resolve_provider=False))
 def code_lenses(ls: MercmacServer, params: t.CodeLensParams) -> list[t.CodeLens]:
     """A "build" lens on each block: its MD lines as `mercmac build` writes them, which
-    the client's `mercmac.copyBuild` copies (docs/editors.md, The language server)."""
+    the client's `mercmac.copyBuild` copies; and a "simulate" lens on `autostart`, which
+    the client's `mercmac.simulate` opens beside the editor (docs/editors.md, The language
+    server)."""
     uri = params.text_document.uri
     seen = ls.checked(uri)
     if seen.rig:
         return []
     document: Document = ls.workspace.get_text_document(uri)
     # a lens with no lines to copy is a label: an empty command, which editors show unclickable
-    return [t.CodeLens(range=t.Range(document.position(lens.line, 1),
-                                     document.position(lens.line, 1)),
-                       command=t.Command(title=lens.title,
-                                         command=lowered.COPY_BUILD if lens.lines else "",
-                                         arguments=[{"macro": lens.macro,
-                                                     "lines": list(lens.lines)}]))
-            for lens in lowered.lenses(seen.items, seen.compilation.program, seen.errors)]
+    at = lambda line: t.Range(document.position(line, 1), document.position(line, 1))  # noqa: E731
+    found = [t.CodeLens(range=at(lens.line),
+                        command=t.Command(title=lens.title,
+                                          command=lowered.COPY_BUILD if lens.lines else "",
+                                          arguments=[{"macro": lens.macro,
+                                                      "lines": list(lens.lines)}]))
+             for lens in lowered.lenses(seen.items, seen.compilation.program, seen.errors)]
+    run = lowered.simulate(seen.items, seen.errors)
+    if run is not None:
+        found.insert(0, t.CodeLens(range=at(run.line), command=t.Command(
+            title=run.title, command="" if seen.errors else lowered.SIMULATE,
+            arguments=[{"uri": uri}])))
+    return found

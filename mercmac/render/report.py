@@ -125,6 +125,18 @@ def write_findings(findings, stream: IO[str] | None = None) -> None:
                len(findings), stream or sys.stderr)
 
 
+def finding_texts(findings, limit: int = MAX_TEXT) -> list[str]:
+    """The errors of checks' findings (all they report when they refuse without one) as
+    `check` words each in text (its line, the source line, the caret), plain, at most
+    `limit` per file: the page of `sim --web` lists why a file that changed is not run."""
+    sources = {f.compilation.source.name: f.compilation.source for f in findings}
+    found = [d for f in findings for d in f.diagnostics]
+    errors = [d for d in found if d.severity is Severity.ERROR]
+    shown, _ = capped(errors or found, limit)
+    return ["\n".join("".join(piece for piece, _ in line)
+                      for line in diagnostic_lines(d, sources.get(d.file))) for d in shown]
+
+
 def capped(diagnostics: Iterable[Diagnostic], limit: int) -> tuple[list[Diagnostic], dict[str, int]]:
     """The diagnostics in order, at most `limit` per file (0: all), and the count left out per file."""
     kept: list[Diagnostic] = []

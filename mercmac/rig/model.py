@@ -18,6 +18,7 @@ from mercmac.source import Span
 # The longest name of a controller or a rig: names become parts of file names (backups,
 # pulled programs), and a file name of 255 bytes or more is refused by the file system.
 NAME_MAX = 64
+PATH_BRANCHES = ("X", "Y", "Z")  # the joystick's branches name the path's axes (§3.6)
 
 
 class LineKind(TextEnum):
@@ -92,6 +93,16 @@ class Rig:
         """Whether the rig has more than one controller: only then are they named in what
         mercmac shows of it (a rig of one shows as its program does)."""
         return len(self.controllers) > 1
+
+    def path_axes(self) -> tuple[str, ...]:
+        """The controllers whose positions draw the stage's path (X, Y and maybe Z): the
+        joystick's branches when it names two or more, else the controllers in the rig's
+        order when there are two or three; none otherwise."""
+        named = tuple(self.joystick[b] for b in PATH_BRANCHES if b in self.joystick)
+        if len(named) >= 2:
+            return named
+        names = tuple(c.name for c in self.controllers)
+        return names if 2 <= len(names) <= 3 else ()
 
     def controller(self, name: str) -> Controller:
         """The controller called `name`; KeyError if the rig has none."""

@@ -19,7 +19,6 @@ from mercmac.rig.model import Rig
 from mercmac.sim import plot
 from mercmac.sim.plot import PlotObserver, TimeAxis, Trace
 
-PATH_BRANCHES = ("X", "Y", "Z")  # the joystick's branches name the path's axes (§3.6)
 # Direction arrows: one on each straight leg, ALONG of the way from its start (so that
 # a raster's rightward and leftward arrows stand in two columns, apart), none on a leg
 # shorter than SHORT_LEG of the picture (the arrow itself is ~5% long), and none nearer
@@ -51,7 +50,7 @@ def trace_of(rig: Rig, watched: dict[str, PlotObserver], end_us: int) -> RigTrac
     traces = {name: w.close(end_us) for name, w in watched.items()}
     wires = {str(w): traces[w.source.controller].outputs.get(w.source.number, [])
              for w in rig.wires}
-    return RigTrace(rig, traces, wires, _buttons(rig, traces), path_axes(rig), end_us)
+    return RigTrace(rig, traces, wires, _buttons(rig, traces), rig.path_axes(), end_us)
 
 
 def _buttons(rig: Rig, traces: dict[str, Trace]) -> dict[int, list]:
@@ -63,16 +62,6 @@ def _buttons(rig: Rig, traces: dict[str, Trace]) -> dict[int, list]:
     if not any(n in pressed for n in buttons):  # a lane of nothing pressed says nothing
         return {}
     return {n: pressed.get(n, []) for n in buttons}
-
-
-def path_axes(rig: Rig) -> tuple[str, ...]:
-    """The path's axes: the joystick's X, Y (and Z) when it names two or more, else the
-    controllers in the rig's order when there are two or three; none otherwise."""
-    named = tuple(rig.joystick[b] for b in PATH_BRANCHES if b in rig.joystick)
-    if len(named) >= 2:
-        return named
-    names = tuple(c.name for c in rig.controllers)
-    return names if 2 <= len(names) <= 3 else ()
 
 
 def joint_axis(traces: list[Trace]) -> TimeAxis:

@@ -132,13 +132,13 @@ class _Handler(BaseHTTPRequestHandler):
         self.send_header("Connection", "close")
         self.end_headers()
         self.close_connection = True
-        live, seen, last, beat = self.server.live, 0, None, time.monotonic()
+        live, seen, last, beat = self.server.live, (0, 0), None, time.monotonic()
         try:
             while not self.server.stopping.is_set():
                 live.advance()
                 state, seen = live.state(seen)
                 data = json.dumps(state, separators=(",", ":"))
-                if data != last or state["lines"]:
+                if data != last or state["log"] or state["path"]:
                     self.wfile.write(f"data: {data}\n\n".encode())
                     self.wfile.flush()
                     last, beat = data, time.monotonic()

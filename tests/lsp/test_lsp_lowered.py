@@ -129,8 +129,12 @@ async def test_the_build_lens_and_the_hover_hold_the_md_lines_build_writes(
     await _open(client, path, PROGRAM)
     lenses = await client.text_document_code_lens_async(t.CodeLensParams(
         text_document=t.TextDocumentIdentifier(uri=path.as_uri())))
-    by_line = {lens.range.start.line + 1: lens.command for lens in lenses}
+    by_line = {lens.range.start.line + 1: lens.command for lens in lenses
+               if lens.command.command != "mercmac.simulate"}
     assert sorted(by_line) == [4, 10, 17]
+    (run,) = [lens for lens in lenses if lens.command.command == "mercmac.simulate"]
+    assert run.range.start.line + 1 == 17 and list(run.command.arguments) == [{"uri": path.as_uri()}]
+    assert run.command.title.startswith("▶ simulate")
     built = _build(path)
     copied = [line for command in by_line.values() for line in command.arguments[0]["lines"]]
     assert sorted(copied) == sorted(built)  # every line once, exactly as build writes it
@@ -153,6 +157,7 @@ async def test_with_errors_the_lens_says_build_writes_nothing(client: LanguageCl
     lenses = await client.text_document_code_lens_async(t.CodeLensParams(
         text_document=t.TextDocumentIdentifier(uri=path.as_uri())))
     assert [(lens.command.title, lens.command.command) for lens in lenses] == [
+        ("simulate: not while the file has 1 error", ""),
         ("build: MC01, not built while the file has 1 error", ""),
         ("build: MC00, not built while the file has 1 error", "")]
     hover = await client.text_document_hover_async(t.HoverParams(

@@ -76,8 +76,12 @@ def test_inlay_hints_and_the_build_lens_answer_neovim(tmp_path):
     assert any(line == 6 for line, _ in labels)  # the when block's own slot
     built = subprocess.run([sys.executable, "-m", "mercmac", "build", str(path)],
                            capture_output=True, text=True, check=True).stdout.splitlines()
-    copied = [line for lens in lenses["result"] for line in lens["command"]["arguments"][0]["lines"]]
+    copied = [line for lens in lenses["result"] if lens["command"]["command"] == "mercmac.copyBuild"
+              for line in lens["command"]["arguments"][0]["lines"]]
     assert sorted(copied) == sorted(built)
+    (run,) = [lens for lens in lenses["result"] if lens["command"]["command"] == "mercmac.simulate"]
+    assert run["range"]["start"]["line"] == 10 and run["command"]["arguments"] == [
+        {"uri": path.as_uri()}]
 
 
 def _tokens(data: list[int], legend: dict, text: str) -> list[tuple[str, str]]:

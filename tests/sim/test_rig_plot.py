@@ -195,11 +195,11 @@ def test_three_axes_give_two_projections():
 
 def test_the_joystick_names_the_path_axes():
     rig = _rig("y", "x")
-    assert rig_plot.path_axes(rig) == ("y", "x")
+    assert rig.path_axes() == ("y", "x")
     joy = Rig(rig.path, rig.name, rig.controllers, joystick={"Y": "y", "X": "x"})
-    assert rig_plot.path_axes(joy) == ("x", "y")
+    assert joy.path_axes() == ("x", "y")
     one = Rig(rig.path, rig.name, rig.controllers[:1])
-    assert rig_plot.path_axes(one) == ()
+    assert one.path_axes() == ()
 
 
 def test_the_box_buttons_have_a_lane_when_pressed():

@@ -27,6 +27,7 @@
   const PLOT_W = 600, PLOT_H = 160;
   const BAR_W = 1000, BAR_H = 56;  // the stage bar's viewBox
   const XY_MAX = 60000;           // path points kept
+  const LOG_KINDS = new Set(["line", "hazard", "note", "error"]);
 
   // How the page reaches the simulation: this server over HTTP, or, in VS Code's webview
   // (which may not reach 127.0.0.1 itself), the extension, which relays to the same server.
@@ -94,7 +95,7 @@
   const history = new Map();   // controller name -> {t: [], p: []}
   let lastT = -Infinity;
   const xy = {pts: [], str: "", minX: Infinity, maxX: -Infinity, minY: Infinity, maxY: -Infinity,
-    changed: false, seen: false};
+    changed: false, seen: false, axes: []};
 
   let cards = new Map();       // controller name -> card parts
   let signature = "";
@@ -145,13 +146,17 @@
   // What each message adds (lines, path, history) is kept as it comes; what it says of the
   // present (positions, LEDs...) is drawn from the latest message only, once per frame.
   function ingest(s) {
-    if (Array.isArray(s.lines)) for (const l of s.lines) pendingLog.push([String(l), "line"]);
-    if (Array.isArray(s.hazards)) for (const l of s.hazards) pendingLog.push([String(l), "hazard"]);
+    // the timeline as [text, kind]: kind "line", "hazard" (a hazard the run reports) or "note"
+    if (Array.isArray(s.log)) {
+      for (const e of s.log) {
+        if (Array.isArray(e)) pendingLog.push([String(e[0]), LOG_KINDS.has(e[1]) ? e[1] : "line"]);
+      }
+    }
     if (pendingLog.length > LOG_MAX) pendingLog = pendingLog.slice(-LOG_MAX);
     if (Array.isArray(s.problems)) pendingProblems = s.problems;
     const t = Number(s.t_ms);
     if (Number.isFinite(t)) {
-      if (t < lastT) { history.clear(); }
+      if (t < lastT) { history.clear(); clearPath(); }  // the file was reloaded: a new run
       lastT = t;
       for (const c of s.controllers || []) {
         let h = history.get(c.name);
@@ -167,6 +172,7 @@
         if (h.t.length > 200000) { h.t.splice(0, 100000); h.p.splice(0, 100000); }
       }
     }
+    if (Array.isArray(s.path_axes)) xy.axes = s.path_axes.map(String);
     if (Array.isArray(s.path) && s.path.length) {
       xy.seen = true;
       for (const pt of s.path) {
@@ -246,10 +252,18 @@
     const softHi = sv("line", {class: "soft", x1: 0, x2: 0, y1: 10, y2: 46, visibility: "hidden"});
     const target = sv("path", {class: "target-mark", d: "M-7 2 L7 2 L0 14 Z"});
     const carriage = sv("rect", {class: "carriage", x: -14, y: 16, width: 28, height: 24, rx: 4});
-    bar.append(rail, zoneLo, zoneHi, softLo, softHi, target, carriage);
+    // the reference switch's edge (MS176E §4.3) and the hard limit switches (§4.4.1)
+    const ref = sv("g", {class: "ref", "data-found": "false", visibility: "hidden"},
+      sv("line", {x1: 0, x2: 0, y1: 4, y2: 52}), sv("text", {x: 4, y: 12, text: ""}));
+    ref.lastChild.textContent = "REF";
+    const limLo = sv("rect", {class: "limit", x: 0, y: 12, width: 8, height: 32, "data-pressed": "false", visibility: "hidden"});
+    const limHi = sv("rect", {class: "limit", x: 0, y: 12, width: 8, height: 32, "data-pressed": "false", visibility: "hidden"});
+    bar.append(rail, zoneLo, zoneHi, softLo, softHi, ref, limLo, limHi, target, carriage);
     const tmin = el("span", {class: "travel-min"});
     const tmax = el("span", {class: "travel-max"});
     const travel = el("div", {class: "travel"}, tmin, el("span", {class: "travel-soft"}), tmax);
+    const switches = el("div", {class: "switches", "aria-label": label(name, "switches")});
+    const hazard = el("div", {class: "card-hazard", role: "status", "aria-label": label(name, "hazard"), hidden: ""});
 
     const pos = el("output", {class: "num pos", "aria-label": label(name, "position"), "aria-live": "off", text: "0"});
     const posUnit = el("span", {class: "unit"});
@@ -280,18 +294,19 @@
       plot,
       el("div", {class: "plot-foot"}, el("span", {text: "−10 s"}), el("span", {text: "position, last 10 s"}), el("span", {text: "now"})));
 
-    const stage = el("div", {class: "stage"}, bar, travel, readout);
+    const stage = el("div", {class: "stage"}, bar, travel, switches, readout);
     const head = el("header", {class: "card-head"},
       el("h2", {class: "card-name", text: name}),
       el("span", {class: "card-model"}),
       el("span", {class: "card-unit"}));
     const body = el("div", {class: "card-body"}, box, stage);
     const joyRow = el("div", {class: "joy-row", hidden: ""});
-    const root = el("article", {class: "card", "data-name": name}, head, body, plotWrap, joyRow);
+    const root = el("article", {class: "card", "data-name": name}, head, hazard, body, plotWrap, joyRow);
     root.addEventListener("pointerdown", () => { if (hasPressable(name)) activeName = name; ask(); });
     root.addEventListener("focusin", () => { if (hasPressable(name)) activeName = name; ask(); });
 
     Object.assign(parts, {root, bar, rail, zoneLo, zoneHi, softLo, softHi, target, carriage, tmin, tmax,
+      ref, limLo, limHi, switches, hazard,
       pos, posUnit, tgt, tgtUnit, macro, plot, line, plotTarget, plotSoftLo, plotSoftHi, joyRow,
       plotMax: plotWrap.querySelector(".plot-max"), plotMin: plotWrap.querySelector(".plot-min"),
       model: head.querySelector(".card-model"), softText: travel.querySelector(".travel-soft"),
@@ -520,11 +535,11 @@
   $("latch").addEventListener("change", () => {
     document.body.classList.toggle("latching", latchOn());
   });
-  $("xy-clear").addEventListener("click", () => {
+  function clearPath() {
     Object.assign(xy, {pts: [], str: "", minX: Infinity, maxX: -Infinity, minY: Infinity,
       maxY: -Infinity, changed: true});
-    ask();
-  });
+  }
+  $("xy-clear").addEventListener("click", () => { clearPath(); ask(); });
 
   // ------------------------------------------------------------------ drawing, once a frame
   function frame() {
@@ -576,13 +591,16 @@
     }
     k.box.classList.toggle("no-box", !(Array.isArray(c.pressable) ? c.pressable.some(Boolean) : true));
 
-    // the travel range, padded a little so the carriage at an end still shows whole
-    let [lo, hi] = Array.isArray(c.travel) && c.travel.length === 2 ? c.travel.map(Number) : [NaN, NaN];
-    const p = Number(c.position), tg = Number(c.target);
+    // the travel: between the limit switches where the bench has them, padded a little so
+    // the carriage at an end still shows whole
+    const sw = Array.isArray(c.limit_switches) && c.limit_switches.length === 2 ? c.limit_switches.map(Number) : null;
+    let [lo, hi] = sw ? [sw[0] - (sw[1] - sw[0]) * 0.03, sw[1] + (sw[1] - sw[0]) * 0.03] : [NaN, NaN];
+    const p = Number(c.position), tg = Number(c.target), rf = Number(c.reference);
     if (!Number.isFinite(lo) || !Number.isFinite(hi) || hi <= lo) {
-      // no travel given: the range seen so far, which only grows, so the bar stays still
+      // no travel given: the range seen so far (the reference switch in it), which only
+      // grows, so the bar stays still
       const r = k.seen || (k.seen = [Infinity, -Infinity]);
-      for (const v of [p, tg]) if (Number.isFinite(v)) { r[0] = Math.min(r[0], v); r[1] = Math.max(r[1], v); }
+      for (const v of [p, tg, rf]) if (Number.isFinite(v)) { r[0] = Math.min(r[0], v); r[1] = Math.max(r[1], v); }
       if (!(r[1] > r[0])) { lo = (Number.isFinite(r[0]) ? r[0] : 0) - 1000; hi = lo + 2000; } else {
         const m = (r[1] - r[0]) * 0.05; lo = r[0] - m; hi = r[1] + m;
       }
@@ -612,8 +630,28 @@
       setAttr(k.softHi, "visibility", "visible");
       setAttr(k.zoneHi, "x", x.toFixed(1)); setAttr(k.zoneHi, "width", Math.max(0, W - pad - x).toFixed(1));
     } else { setAttr(k.softHi, "visibility", "hidden"); setAttr(k.zoneHi, "width", 0); }
-    setText(k.tmin, fmt(lo));
-    setText(k.tmax, fmt(hi));
+    if (Number.isFinite(rf) && rf >= lo && rf <= hi) {
+      setAttr(k.ref, "transform", `translate(${X(rf).toFixed(1)} 0)`);
+      setAttr(k.ref, "visibility", "visible");
+    } else setAttr(k.ref, "visibility", "hidden");
+    setAttr(k.ref, "data-found", c.referenced ? "true" : "false");
+    for (const [rect, at, side] of [[k.limLo, sw && sw[0], "negative"], [k.limHi, sw && sw[1], "positive"]]) {
+      if (sw) {
+        setAttr(rect, "x", (X(at) - (side === "negative" ? 8 : 0)).toFixed(1));
+        setAttr(rect, "visibility", "visible");
+        setAttr(rect, "data-pressed", c.at_limit === side ? "true" : "false");
+      } else setAttr(rect, "visibility", "hidden");
+    }
+    const swText = [Number.isFinite(rf) ? `reference switch at ${fmt(rf)}${c.referenced ? " (found)" : ""}` : "",
+      sw ? `limit switches at ${fmt(sw[0])} and ${fmt(sw[1])}` : "no limit switches",
+      c.at_limit ? `on the ${c.at_limit} limit switch` : ""].filter(Boolean).join(" · ");
+    setText(k.switches, swText);
+    k.switches.classList.toggle("at-limit", !!c.at_limit);
+    if (c.hazard) { setText(k.hazard, "⚠ hazard " + c.hazard); if (k.hazard.hidden) k.hazard.hidden = false; }
+    else if (!k.hazard.hidden) k.hazard.hidden = true;
+    k.root.classList.toggle("hazardous", !!c.hazard);
+    setText(k.tmin, fmt(sw ? sw[0] : lo));
+    setText(k.tmax, fmt(sw ? sw[1] : hi));
     setText(k.softText, sLo === null && sHi === null ? "no soft limits"
       : `soft limits ${sLo === null ? "–" : fmt(sLo)} … ${sHi === null ? "–" : fmt(sHi)}`);
 
@@ -720,10 +758,11 @@
     if (panel.hidden === xy.seen) panel.hidden = !xy.seen;
     if (!xy.seen || !xy.changed) return;
     xy.changed = false;
-    // the frame: the travel of the first two axes (if known) and whatever the path covers
+    // the frame: the travel of the path's X and Y axes (if known) and whatever the path covers
     let minX = xy.minX, maxX = xy.maxX, minY = xy.minY, maxY = xy.maxY;
-    if (list.length >= 2) {
-      const tx = list[0].travel, ty = list[1].travel;
+    const named = (i) => list.find((c) => c.name === xy.axes[i]);
+    if (xy.axes.length >= 2 && named(0) && named(1)) {
+      const tx = named(0).limit_switches, ty = named(1).limit_switches;
       if (Array.isArray(tx) && tx.length === 2) { minX = Math.min(minX, tx[0]); maxX = Math.max(maxX, tx[1]); }
       if (Array.isArray(ty) && ty.length === 2) { minY = Math.min(minY, ty[0]); maxY = Math.max(maxY, ty[1]); }
     }
@@ -746,7 +785,8 @@
       dot.setAttribute("r", Math.max(w, h) * 0.012);
       dot.setAttribute("visibility", "visible");
     } else dot.setAttribute("visibility", "hidden");
-    setText($("xy-range"), `x ${fmt(minX)} … ${fmt(maxX)}   y ${fmt(minY)} … ${fmt(maxY)}`);
+    const [nx, ny] = xy.axes.length >= 2 ? xy.axes : ["x", "y"];
+    setText($("xy-range"), `${nx} ${fmt(minX)} … ${fmt(maxX)} (across)   ${ny} ${fmt(minY)} … ${fmt(maxY)} (up)`);
   }
 
   const logEl = $("log");
