@@ -1,5 +1,7 @@
 """Screenshots of the page of `sim --web` for docs/: the manual's Example 4 in mode 3 with
-button 1 held, and the raster rig scanning.
+button 1 held (web-box.png), the raster rig scanning (web-rig.png), a jog run into its soft
+limit on a bench with limit switches (web-hazard.png), and a saved change with an error
+while the last good program runs (web-problems.png).
 
     .venv/bin/python tools/web_screens.py [OUT_FOLDER]   (default: docs/)
 
@@ -7,7 +9,11 @@ Needs playwright (the test extra) and Debian's chromium.
 """
 from __future__ import annotations
 
+import re
+import signal
+import subprocess
 import sys
+import tempfile
 import threading
 import time
 from pathlib import Path
@@ -19,12 +25,13 @@ FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 
 
-def served(path: Path, speed: float):
+def served(path: Path, speed: float, **bench):
     from helpers.web import simulation
+    from mercmac.vm.models import Options
     from mercmac.web.live import Live
     from mercmac.web.server import WebServer
 
-    server = WebServer(Live(simulation(path), path.name, speed=speed))
+    server = WebServer(Live(simulation(path, Options(**bench)), path.name, speed=speed))
     threading.Thread(target=server.serve_forever, daemon=True).start()
     return server
 
@@ -33,6 +40,43 @@ def wait(server, ms: float) -> None:
     goal = server.live.sim.now_ms() + ms
     while server.live.sim.now_ms() < goal:
         time.sleep(0.02)
+
+
+JOG = """\
+// a focus jog: button 1 up, button 2 down, to the soft limits
+target C-663
+autostart {
+    JL -20000, JH 20000
+    SV 8000
+    goto jog
+}
+macro jog {
+    every 20ms {
+        when 1 { MR 9999999, WF 1, AB 1 }
+        when 2 { MR -9999999, WF 2, AB 1 }
+    }
+}
+"""
+
+
+def problems(page, program: Path, shot: Path) -> None:
+    """`sim --web` as a process on `program`; a save with a typo in it; the page then."""
+    process = subprocess.Popen([sys.executable, "-m", "mercmac", "sim", str(program), "--web",
+                                "--no-open"], stderr=subprocess.PIPE, text=True,
+                               stdin=subprocess.DEVNULL)
+    try:
+        url = re.search(r"http://\S+", process.stderr.readline()).group()
+        page.goto(url)
+        page.get_by_role("button", name="button 1", exact=True).wait_for()
+        time.sleep(1)
+        good = program.read_text(encoding="utf-8")
+        program.write_text(good.replace("SV 8000", "SV 8000, MX 5"), encoding="utf-8")
+        page.locator("#problems:not([hidden])").wait_for()
+        time.sleep(0.5)
+        page.screenshot(path=str(shot))
+    finally:
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=30)
 
 
 def main() -> None:
@@ -67,6 +111,18 @@ def main() -> None:
         wait(rig, 6000)
         page.screenshot(path=str(out / "web-rig.png"), full_page=True)
         rig.shutdown()
+        with tempfile.TemporaryDirectory() as folder:
+            jog = Path(folder) / "focus.mcm"
+            jog.write_text(JOG, encoding="utf-8")
+            hazard = served(jog, 1.0, reference_at=-5000, hard_limits=(-30000, 30000))
+            page.goto(hazard.url)
+            page.get_by_role("button", name="button 1", exact=True).hover()
+            page.mouse.down()
+            wait(hazard, 2500)
+            page.screenshot(path=str(out / "web-hazard.png"))
+            page.mouse.up()
+            hazard.shutdown()
+            problems(page, jog, out / "web-problems.png")
         browser.close()
 
 

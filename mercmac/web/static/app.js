@@ -254,7 +254,7 @@
     const carriage = sv("rect", {class: "carriage", x: -14, y: 16, width: 28, height: 24, rx: 4});
     // the reference switch's edge (MS176E §4.3) and the hard limit switches (§4.4.1)
     const ref = sv("g", {class: "ref", "data-found": "false", visibility: "hidden"},
-      sv("line", {x1: 0, x2: 0, y1: 4, y2: 52}), sv("text", {x: 4, y: 12, text: ""}));
+      sv("line", {x1: 0, x2: 0, y1: 14, y2: 54}), sv("text", {x: 4, y: 54, text: ""}));
     ref.lastChild.textContent = "REF";
     const limLo = sv("rect", {class: "limit", x: 0, y: 12, width: 8, height: 32, "data-pressed": "false", visibility: "hidden"});
     const limHi = sv("rect", {class: "limit", x: 0, y: 12, width: 8, height: 32, "data-pressed": "false", visibility: "hidden"});
