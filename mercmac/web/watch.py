@@ -7,7 +7,9 @@ the last good one keeps running.
 The files are polled, their modification time and size every PERIOD_S: the standard
 library has no change notification that works alike on Linux, macOS and Windows, and a
 few files looked at twice a second cost nothing. An editor that saves by writing a new
-file and renaming it over the old is seen the same way.
+file and renaming it over the old is seen the same way. A change is read once the files
+have stood still for SETTLE_S, so that a save caught half written (truncated, then
+written) is not run as a program of its own.
 """
 from __future__ import annotations
 
@@ -20,6 +22,8 @@ from mercmac.sim.simulate import Simulation
 from mercmac.web.live import Live
 
 PERIOD_S = 0.5
+SETTLE_S = 0.1
+SETTLE_LOOKS = 20  # a file written for longer than this (2 s) is read as it stands
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,11 +67,20 @@ class Watcher:
         while not self.stopping.wait(PERIOD_S):
             self.look()
 
+    def _stamps(self) -> dict[str, Stamp]:
+        return {p: _stamp(p) for p in self.stamps}
+
     def look(self) -> bool:
         """Look once; whether a file had changed (and the file was opened again)."""
-        now = {p: _stamp(p) for p in self.stamps}
+        now = self._stamps()
         if now == self.stamps:
             return False
+        for _ in range(SETTLE_LOOKS):
+            if self.stopping.wait(SETTLE_S):
+                return False
+            again, now = now, self._stamps()
+            if again == now:
+                break
         try:
             loaded = self.load()
         except Exception as e:  # noqa: BLE001 - the session goes on; the page says what broke

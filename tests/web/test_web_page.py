@@ -157,3 +157,60 @@ def test_the_raster_rig_runs_from_the_box_on_x(browser, serve):
     sync_api.expect(seen.named("y position")).not_to_have_text("0")
     assert seen.hosts == {f"127.0.0.1:{server.port}"}
     assert seen.errors == []
+
+
+CLAMPED = """\
+autostart {
+    JL -20000, JH 20000
+    SV 50000
+    MA 50000
+}
+"""
+
+
+def test_a_hazard_is_marked_on_the_card_and_in_the_timeline(browser, serve, tmp_path):
+    path = tmp_path / "clamped.mcm"
+    path.write_text(CLAMPED, encoding="utf-8")
+    server = serve(path)
+    seen = Watched(browser, server)
+    warning = seen.named("hazard")
+    sync_api.expect(warning).to_be_visible()
+    sync_api.expect(warning).to_contain_text("soft-limit-clamp")
+    sync_api.expect(seen.page.locator(".log-line.hazard")).to_have_count(1)
+    seen.button("power cycle").click()
+    sync_api.expect(warning).to_be_hidden()
+    assert seen.errors == []
+
+
+def test_a_save_with_an_error_is_shown_and_the_last_good_program_runs(browser, tmp_path):
+    """`sim --web` as a process: the page lists the error of a saved change as `check` words
+    it, goes on running, and drops the list when the file is fixed."""
+    import os
+    import signal
+
+    path = tmp_path / "four-modes.mcm"
+    good = EXAMPLE4.read_text(encoding="utf-8")
+    path.write_text(good, encoding="utf-8")
+    process = subprocess.Popen([sys.executable, "-m", "mercmac", "sim", str(path), "--web",
+                                "--no-open"], stderr=subprocess.PIPE, text=True,
+                               stdin=subprocess.DEVNULL, env={**os.environ, "DISPLAY": ""})
+    try:
+        url = re.search(r"http://127\.0\.0\.1:\d+/\?token=[\w-]+", process.stderr.readline())
+        assert url
+        page = browser.new_page()
+        page.set_default_timeout(WAIT_MS)
+        page.goto(url.group())
+        page.get_by_role("button", name="button 1", exact=True).wait_for()
+        path.write_text(good + "\nmacro typo {\n    MX 5\n}\n", encoding="utf-8")
+        problems = page.locator("#problems")
+        sync_api.expect(problems).to_be_visible()
+        sync_api.expect(problems).to_contain_text("error[MM002 unknown-command]: unknown command 'MX'")
+        clock = page.get_by_label("simulated time")
+        before = float(clock.text_content())
+        sync_api.expect(clock).not_to_have_text(f"{before:.3f}")  # the last good one runs
+        path.write_text(good, encoding="utf-8")
+        sync_api.expect(problems).to_be_hidden()
+        sync_api.expect(page.locator(".log-line.note", has_text="reloaded").first).to_be_visible()
+    finally:
+        process.send_signal(signal.SIGINT)
+        assert process.wait(timeout=30) == 130
