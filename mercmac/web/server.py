@@ -25,8 +25,11 @@ from urllib.parse import parse_qs, urlsplit
 
 from mercmac.web.live import Live
 
-FRAME_S = 1 / 30  # the event stream's period while the simulation runs
-IDLE_S = 0.25  # and while it is paused
+# The event stream's period while something moves: on a fixed schedule, a little more often
+# than the page's goal of 30 frames a second, so that a late wake-up never drops it below.
+FRAME_S = 1 / 32
+STILL_S = 0.1  # while only the clock goes on, the clock is sent this often
+IDLE_S = 0.25  # and while the simulation is paused
 BEAT_S = 15.0  # a comment line this often keeps proxies and the browser from timing out
 MAX_BODY = 4096  # a POST of the page is a few dozen bytes
 ASSETS = {"app.js": "text/javascript", "style.css": "text/css"}
@@ -132,21 +135,26 @@ class _Handler(BaseHTTPRequestHandler):
         self.send_header("Connection", "close")
         self.end_headers()
         self.close_connection = True
-        live, seen, last, beat = self.server.live, (0, 0), None, time.monotonic()
+        live, seen, last, last_clock = self.server.live, (0, 0), None, None
+        sent = due = time.monotonic()
         try:
             while not self.server.stopping.is_set():
                 live.advance()
                 state, seen = live.state(seen)
-                data = json.dumps(state, separators=(",", ":"))
-                if data != last or state["log"] or state["path"]:
-                    self.wfile.write(f"data: {data}\n\n".encode())
+                clock = state.pop("t_ms")
+                rest = json.dumps(state, separators=(",", ":"))
+                now = time.monotonic()
+                if (rest != last or state["log"] or state["path"]
+                        or (clock != last_clock and now - sent >= STILL_S)):
+                    self.wfile.write(f'data: {{"t_ms":{clock},{rest[1:]}\n\n'.encode())
                     self.wfile.flush()
-                    last, beat = data, time.monotonic()
-                elif time.monotonic() - beat > BEAT_S:
+                    last, last_clock, sent = rest, clock, now
+                elif now - sent > BEAT_S:  # paused: a comment keeps the stream open
                     self.wfile.write(b": still here\n\n")
                     self.wfile.flush()
-                    beat = time.monotonic()
-                self.server.stopping.wait(IDLE_S if live.paused else FRAME_S)
+                    sent = now
+                due = max(due + (IDLE_S if live.paused else FRAME_S), now)
+                self.server.stopping.wait(due - now)
         except (BrokenPipeError, ConnectionResetError):
             pass  # the page was closed
 
