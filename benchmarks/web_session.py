@@ -14,7 +14,8 @@ messages, with the simulated time (t_ms) each carries. CPU is user + system time
 /proc/PID/stat over the window, in % of one core: the server's process (all its threads), and
 the browser's (every chromium process under this one; drawn in software, --disable-gpu). The
 page draws at most once per message, so its frames a second are bounded by the stream's rate
-(FRAME_S in mercmac/web/server.py). Nothing is asserted: the figures, and
+(FRAME_S in mercmac/web/server.py; while only the clock goes on, STILL_S sends it about
+10 times a second, so (b) and (c) draw fewer frames by design). Nothing is asserted: the figures, and
 each goal as a ratio (figure / goal), are printed, measured in this one run.
 
 (a) moving: examples/macros/four-modes.mcm (the manual's Example 4) with `--hold 1`: mode 1,
