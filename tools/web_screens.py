@@ -59,6 +59,17 @@ macro jog {
 """
 
 
+def shot_held(page, server, button: str, ms: float, shot: Path) -> None:
+    """The page after `button` has been held with the mouse for `ms` of simulated time;
+    the server stopped then."""
+    page.get_by_role("button", name=button, exact=True).hover()
+    page.mouse.down()
+    wait(server, ms)
+    page.screenshot(path=str(shot))
+    page.mouse.up()
+    server.shutdown()
+
+
 def problems(page, program: Path, shot: Path) -> None:
     """`sim --web` as a process on `program`; a save with a typo in it; the page then."""
     process = subprocess.Popen([sys.executable, "-m", "mercmac", "sim", str(program), "--web",
@@ -96,12 +107,7 @@ def main() -> None:
         wait(box, 600)
         page.keyboard.up("3")
         wait(box, 300)
-        page.get_by_role("button", name="button 1", exact=True).hover()
-        page.mouse.down()
-        wait(box, 1500)
-        page.screenshot(path=str(out / "web-box.png"))
-        page.mouse.up()
-        box.shutdown()
+        shot_held(page, box, "button 1", 1500, out / "web-box.png")
         rig = served(ROOT / "examples" / "rigs" / "raster" / "raster.rig.toml", 10.0)
         page.goto(rig.url)
         page.get_by_role("button", name="x button 1", exact=True).hover()
@@ -116,12 +122,7 @@ def main() -> None:
             jog.write_text(JOG, encoding="utf-8")
             hazard = served(jog, 1.0, reference_at=-5000, hard_limits=(-30000, 30000))
             page.goto(hazard.url)
-            page.get_by_role("button", name="button 1", exact=True).hover()
-            page.mouse.down()
-            wait(hazard, 2500)
-            page.screenshot(path=str(out / "web-hazard.png"))
-            page.mouse.up()
-            hazard.shutdown()
+            shot_held(page, hazard, "button 1", 2500, out / "web-hazard.png")
             problems(page, jog, out / "web-problems.png")
         browser.close()
 
