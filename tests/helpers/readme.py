@@ -34,13 +34,23 @@ def code_lines() -> list[str]:
     return lines
 
 
+def _all_commands() -> list[str]:
+    return [re.split(r"\s+#\s", line, maxsplit=1)[0].strip() for line in code_lines()
+            if line.startswith("mercmac ")]
+
+
 def commands() -> list[str]:
-    """Each `mercmac ...` command line, without its trailing `# comment`."""
-    found = []
-    for line in code_lines():
-        if line.startswith("mercmac "):
-            found.append(re.split(r"\s+#\s", line, maxsplit=1)[0].strip())
-    return found
+    """Each `mercmac ...` command line that ends by itself, without its trailing `# comment`."""
+    return [c for c in _all_commands() if not serves(c)]
+
+
+def served_commands() -> list[str]:
+    """The README's commands that serve until Ctrl-C (`sim --web`): run as processes."""
+    return [c for c in _all_commands() if serves(c)]
+
+
+def serves(command: str) -> bool:
+    return " --web" in f" {command} "
 
 
 def tour_program() -> str:

@@ -18,7 +18,8 @@ import pytest
 from helpers.cli import cli
 from helpers.emulator import line_clock
 from helpers.paths import EXAMPLE4
-from helpers.readme import HARDWARE_PORTS, README, commands, prepare, promise, tour_program
+from helpers.readme import (HARDWARE_PORTS, README, commands, prepare, promise, served_commands,
+                            tour_program)
 
 
 @pytest.fixture(scope="module")
@@ -52,6 +53,34 @@ def run(command: str, port: str, folder: Path, monkeypatch):
 
 
 COMMANDS = commands()
+
+
+@pytest.mark.parametrize("command", served_commands())
+def test_a_readme_command_that_serves_prints_its_address_and_serves_the_page(command):
+    """`sim ... --web` from the top of the repository, as the README says: a process that
+    prints its address, serves the page there and stops on Ctrl-C (exit 130)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import urllib.request
+
+    from helpers.paths import ROOT
+
+    process = subprocess.Popen([sys.executable, "-m", "mercmac", *shlex.split(command)[1:],
+                                "--no-open"], cwd=ROOT, stderr=subprocess.PIPE, text=True,
+                               stdout=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
+                               env={**os.environ, "DISPLAY": ""})
+    try:
+        url = re.search(r"http://127\.0\.0\.1:\d+/\?token=[\w-]+", process.stderr.readline())
+        assert url, command
+        with urllib.request.urlopen(url.group(), timeout=60) as page:
+            assert page.status == 200 and b"mercmac sim" in page.read()
+        process.send_signal(signal.SIGINT)
+        assert process.wait(timeout=60) == 130
+    finally:
+        process.kill()
+        process.wait()
 
 
 def test_the_readme_shows_commands_and_the_tour_program():

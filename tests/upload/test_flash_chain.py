@@ -6,11 +6,12 @@ from __future__ import annotations
 import io
 import re
 import signal
+import time
 from contextlib import contextmanager
 
 import pytest
 
-from helpers.emulator import FAST_TIMING
+from helpers.emulator import FAST_TIMING, ROOM_S
 from mercmac.emulator.chain import Chain
 from mercmac.emulator.ptyserver import PtyServer
 from mercmac.emulator.virtual import VirtualController
@@ -26,10 +27,16 @@ PROGRAM = "target C-663\n[MC00] EM5\n[MC03] MR200,WS0\n"
 
 @contextmanager
 def serving(*addresses: int):
-    """C-663s at ADDRESSES on one pty, holding {0: EM1}: yields the server and its byte log."""
+    """C-663s at ADDRESSES on one pty, holding {0: EM1}: yields the server and its byte log
+    once macro 0 has ended on each (a macro still running when the flash asks `%` makes it
+    ask again after VE, MS176E §3.8.3: on a loaded machine that was the only difference)."""
     log = io.StringIO()
     vcs = [VirtualController("C-663", a, macros={0: "EM1"}) for a in addresses]
     with PtyServer(Chain(vcs), log) as server:
+        deadline = time.monotonic() + ROOM_S
+        while any(vc.running for vc in vcs):
+            assert time.monotonic() < deadline, "macro 0 did not end"
+            time.sleep(0.01)
         yield server, log
 
 
