@@ -13,6 +13,7 @@ from __future__ import annotations
 import os
 import re
 import sys
+import threading
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 
@@ -54,6 +55,7 @@ class Request:
     web: bool = False  # the box in the browser (mercmac.web)
     port: int = 0  # --web: 0, a free one
     open_page: bool = True  # --web: open the default browser on the page
+    stdin_stops: bool = False  # --web: stop when standard input ends (an editor's pipe)
     joystick: str = ""  # a rig: NAME=D@T1-T2,...
     allow_hazard: tuple[str, ...] = ()  # hazard rules accepted for the run
 
@@ -114,8 +116,10 @@ def _run(req: Request) -> bool:
     programs = {name: c.program for name, c in accepted.programs.items()}
     if req.web:  # first: it refuses the options of the other ways to run
         return _web(req, rig, programs, script, options, _read_from(accepted.findings, req))
-    if req.port or not req.open_page:
-        raise UsageError(f"{'--port' if req.port else '--no-open'} is for --web")
+    for given, option in ((req.port, "--port"), (not req.open_page, "--no-open"),
+                          (req.stdin_stops, "--stop-when-stdin-closes")):
+        if given:
+            raise UsageError(f"{option} is for --web")
     if req.interactive:
         return _interactive(req, rig, programs, script, options)
     if req.scenario:
@@ -360,12 +364,29 @@ def _web(req: Request, rig: Rig, programs: dict, script: Script, options: Option
     say("Ctrl-C stops it" + ("" if _opened(server.url, req.open_page) else
                              "; open the address above in a browser"))
     watcher.start()
+    if req.stdin_stops:
+        threading.Thread(target=_stop_at_end_of_input, args=(server,), name="mercmac-stdin",
+                         daemon=True).start()
     try:
         server.serve_forever()  # Ctrl-C: KeyboardInterrupt, exit 130 (cli/common.py)
     finally:
         watcher.stop()
         server.server_close()
     return True
+
+
+def _stop_at_end_of_input(server) -> None:
+    """--stop-when-stdin-closes: the editor that started this process on a pipe is gone
+    when the pipe ends, however it went (a crash leaves no `deactivate` to stop us)."""
+    # the file descriptor, not sys.stdin: a thread blocked in a buffered read holds its
+    # lock, and the interpreter aborts on it when Ctrl-C ends the process meanwhile
+    try:
+        while os.read(0, 4096):
+            pass
+    except OSError:
+        pass  # no standard input to read: it has ended too
+    say("standard input closed: stopped")
+    server.shutdown()
 
 
 def _reopened(req: Request, options: Options):

@@ -49,6 +49,9 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
               help="With --web: the port (default: a free one).")
 @click.option("--no-open", "no_open", is_flag=True,
               help="With --web: print the address, open no browser.")
+@click.option("--stop-when-stdin-closes", "stdin_stops", is_flag=True,
+              help="With --web: stop when standard input ends, for an editor that starts it "
+                   "on a pipe (the pipe closes when the editor goes).")
 @click.option("--speed", type=FiniteFloat(), default=1.0, show_default=True,
               help="Simulated seconds per wall-clock second in --interactive and --web.")
 @click.option("--scenario", type=click.Path(dir_okay=False), metavar="FILE.toml",
@@ -71,7 +74,7 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
 @click.option("--hard-limits", default=None, metavar="NEG,POS",
               help="Positions of the limit switches, e.g. -200000,200000 (default: none).")
 def sim(file, buttons, joystick, until, fmt, verbose, trace, vcd, vcd_limit, plot, interactive, hold,
-        web, port, no_open, speed, scenario, fail_on_hazard, allow, target, cycle, servo_off,
+        web, port, no_open, stdin_stops, speed, scenario, fail_on_hazard, allow, target, cycle, servo_off,
         reference_at, hard_limits) -> None:
     """Simulate FILE on a virtual controller with a scripted pushbutton box; a rig file
     (*.rig.toml) runs every controller on one clock (--buttons NAME:B@T1-T2).
@@ -89,7 +92,7 @@ def sim(file, buttons, joystick, until, fmt, verbose, trace, vcd, vcd_limit, plo
             cycle_ms=cycle, servo_off=servo_off, reference_at=reference_at,
             hard_limits=hard_limits, fail_on_hazard=fail_on_hazard, hold=hold,
             verbose=verbose, joystick=joystick, allow_hazard=allow, web=web, port=port,
-            open_page=not no_open)
+            open_page=not no_open, stdin_stops=stdin_stops)
         return EXIT_OK if run.run(request) else EXIT_FAILED
 
     run_guarded(work)

@@ -151,6 +151,26 @@ def test_the_command_prints_its_address_and_stops_on_ctrl_c():
     assert "Traceback" not in process.stderr.read()
 
 
+def test_an_editor_that_goes_takes_the_process_with_it():
+    """--stop-when-stdin-closes: the extension starts `sim --web` on a pipe, which ends
+    however the editor goes (a crash runs no clean-up): the process stops then."""
+    process = subprocess.Popen([sys.executable, "-m", "mercmac", "sim", str(FOUR_MODES), "--web",
+                                "--no-open", "--stop-when-stdin-closes"], stdin=subprocess.PIPE,
+                               stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True,
+                               env={**os.environ, "DISPLAY": ""})
+    try:
+        assert "http://127.0.0.1:" in process.stderr.readline()
+        time.sleep(0.5)
+        assert process.poll() is None  # an open pipe keeps it serving
+        process.stdin.close()
+        assert process.wait(timeout=WAIT_S) == 0
+    finally:
+        process.kill()
+        process.wait()
+    said = process.stderr.read()
+    assert "standard input closed: stopped" in said and "Traceback" not in said
+
+
 def test_a_scenario_is_saved_at_a_whole_millisecond(tmp_path):
     """Motion goes on within a millisecond: a scenario saved while the clock stood between two
     expected a position the replay never has at a whole one."""
@@ -183,7 +203,7 @@ def test_options_the_page_replaces_are_refused_with_web():
 
 
 def test_web_options_without_web_are_refused():
-    for option in (["--port", "8123"], ["--no-open"]):
+    for option in (["--port", "8123"], ["--no-open"], ["--stop-when-stdin-closes"]):
         done = subprocess.run([sys.executable, "-m", "mercmac", "sim", str(FOUR_MODES), *option],
                               capture_output=True, text=True, timeout=60,
                               stdin=subprocess.DEVNULL)

@@ -18,6 +18,7 @@
 //   lib/session.mjs    one code-server + chromium page + the probe
 //   checks/core.mjs    activation .. inlay-hints
 //   checks/features.mjs  code lenses, semantic tokens, folding, ... , commands, icon
+//   checks/simulate.mjs  mercmac: Simulate (the sim --web page in a webview)
 //   checks/sessions.mjs  the checks with a code-server of their own: missing-lsp, restricted-mode
 
 import fs from "node:fs";
@@ -30,6 +31,7 @@ import { makeWorkspace } from "./lib/workspace.mjs";
 import { coreChecks } from "./checks/core.mjs";
 import { featureChecks, FEATURE_CHECKS } from "./checks/features.mjs";
 import { missingLspSession, restrictedModeSession } from "./checks/sessions.mjs";
+import { simulateChecks, SIMULATE_CHECKS } from "./checks/simulate.mjs";
 
 const CORE_CHECKS = [
   "activation", "diagnostics", "hover-command", "hover-macro", "format", "quick-fix",
@@ -37,7 +39,7 @@ const CORE_CHECKS = [
 ];
 /** The checks that need a code-server of their own (each starts one). */
 const OWN_SESSION = ["restricted-mode", "missing-lsp"];
-const CHECKS = [...CORE_CHECKS, ...FEATURE_CHECKS, ...OWN_SESSION];
+const CHECKS = [...CORE_CHECKS, ...FEATURE_CHECKS, ...SIMULATE_CHECKS, ...OWN_SESSION];
 const HELP = `usage: node editors/vscode/e2e/run.mjs [options]
 
   --out DIR        screenshots and logs (default: editors/vscode/e2e/out)
@@ -105,7 +107,7 @@ async function main() {
   const tools = { node, codeServer };
   const browserType = await loadPlaywright();
   const wanted = (name) => !options.only || options.only.includes(name);
-  const wantMain = [...CORE_CHECKS, ...FEATURE_CHECKS].some(wanted);
+  const wantMain = [...CORE_CHECKS, ...FEATURE_CHECKS, ...SIMULATE_CHECKS].some(wanted);
   const nolsp = wanted("missing-lsp") ? ensureNoLspVenv(options) : null;
 
   const scratch = fs.mkdtempSync(path.join(os.tmpdir(), "mercmac-e2e-"));
@@ -131,6 +133,7 @@ async function main() {
       try {
         await coreChecks(session, options);
         await featureChecks(session, options);
+        await simulateChecks(session, options);
       } finally {
         await session.stop();
       }

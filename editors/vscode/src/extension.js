@@ -6,6 +6,8 @@
 //   status.js    the language status item
 //   messages.js  what a failure says
 //   commands.js  copyBuild (the code lens's command), --version
+//   simulate.js  mercmac.simulate: `mercmac sim FILE --web` in a webview (relay.js, page.js,
+//                bridge.js)
 "use strict";
 const vscode = require("vscode");
 const { Session, clientOptions } = require("./session");
@@ -13,12 +15,14 @@ const { Status } = require("./status");
 const { describeFailure, INSTALL_HINT } = require("./messages");
 const { copyBuild, askVersion } = require("./commands");
 const { locate } = require("./server");
+const { Simulations } = require("./simulate");
 
 // For the extension's life (activate to deactivate): one log channel, whatever the number
 // of restarts; the status item; the current session.
 let channel;
 let status;
 let session;
+let simulations; // the panels of mercmac.simulate and their processes
 let queue = Promise.resolve(); // see enqueue
 let active = false;
 
@@ -133,6 +137,9 @@ function activate(context) {
   session = undefined;
   queue = Promise.resolve();
   active = true;
+  // the same executable, run where the language server runs, as the server is
+  simulations = new Simulations(channel, () => ({ command: executable(), cwd: folder() }),
+    context.extensionUri && vscode.Uri.joinPath(context.extensionUri, "icons", "mcm.svg"));
   context.subscriptions.push(
     channel,
     status,
@@ -140,6 +147,7 @@ function activate(context) {
     vscode.commands.registerCommand("mercmac.showServerLog", () => channel.show(true)),
     vscode.commands.registerCommand("mercmac.showVersion", () => showVersion()),
     vscode.commands.registerCommand("mercmac.copyBuild", (argument) => copyBuild(argument)),
+    vscode.commands.registerCommand("mercmac.simulate", (argument) => simulations.run(argument)),
     vscode.workspace.onDidChangeConfiguration((event) => {
       if (event.affectsConfiguration("mercmac.path")) {
         return restart();
@@ -159,7 +167,8 @@ function activate(context) {
 
 function deactivate() {
   active = false;
-  return enqueue(stopSession);
+  const stopping = simulations ? simulations.dispose() : undefined;
+  return Promise.all([stopping, enqueue(stopSession)]).then(() => undefined);
 }
 
 /** The running client, if any (for the tests). */
@@ -167,4 +176,9 @@ function current() {
   return session && session.running() ? session.client : undefined;
 }
 
-module.exports = { activate, deactivate, clientOptions, current, describeFailure };
+/** The simulations that run, [{file, pid, running, title}] (for the tests). */
+function simulating() {
+  return simulations ? simulations.list() : [];
+}
+
+module.exports = { activate, deactivate, clientOptions, current, describeFailure, simulating };

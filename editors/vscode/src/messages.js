@@ -73,4 +73,4 @@ const SHORT = {
   failed: "not running",
 };
 
-module.exports = { INSTALL_HINT, reasonFrom, describeFailure, SHORT };
+module.exports = { INSTALL_HINT, reasonFrom, describeFailure, ending, SHORT };

@@ -1,6 +1,7 @@
 // The server process, spawned by us rather than by vscode-languageclient: so that we keep
 // the last lines of its standard error (the reason it stopped, quoted in our one message)
-// and know when it has ended, all its output read.
+// and know when it has ended, all its output read. `mercmac sim --web` (simulate.js) is run
+// the same way.
 "use strict";
 const childProcess = require("child_process");
 const fs = require("fs");
@@ -79,14 +80,43 @@ class ServerInput extends Writable {
   }
 }
 
-/** One run of `COMMAND lsp --stdio` in CWD; its standard error goes to LOG as it comes. */
+/** The processes below PID (their ids), from /proc where there is one (Linux); else none. */
+function descendants(pid) {
+  let entries;
+  try {
+    entries = fs.readdirSync("/proc").filter((entry) => /^\d+$/.test(entry));
+  } catch {
+    return [];
+  }
+  const children = new Map();
+  for (const entry of entries) {
+    try {
+      const stat = fs.readFileSync(`/proc/${entry}/stat`, "utf8");
+      const parent = Number(stat.slice(stat.lastIndexOf(")") + 2).split(" ")[1]);
+      if (!children.has(parent)) children.set(parent, []);
+      children.get(parent).push(Number(entry));
+    } catch {
+      // gone meanwhile
+    }
+  }
+  const found = [];
+  const walk = (parent) => (children.get(parent) || []).forEach((child) => {
+    found.push(child);
+    walk(child);
+  });
+  walk(pid);
+  return found;
+}
+
+/** One run of `COMMAND lsp --stdio` (or COMMAND ARGS) in CWD; its standard error goes to LOG
+ *  as it comes. */
 class ServerProcess {
-  constructor(command, cwd, log) {
+  constructor(command, cwd, log, args = ["lsp", "--stdio"]) {
     this.command = command;
     this.lines = [];
     this.partial = "";
     this.initialized = false; // set by Session when the client reaches Running
-    this.child = childProcess.spawn(command, ["lsp", "--stdio"], { cwd, stdio: "pipe" });
+    this.child = childProcess.spawn(command, args, { cwd, stdio: "pipe" });
     // `spawn` fails asynchronously (ENOENT, EACCES): an 'error' event instead of 'spawn'
     this.spawned = new Promise((resolve, reject) => {
       this.child.once("spawn", resolve);
@@ -123,6 +153,23 @@ class ServerProcess {
     return Promise.race([this.exited, late]).finally(() => clearTimeout(timer));
   }
 
+  /** Send SIGNAL to it and to OTHERS (process ids: its descendants, say, so that a
+   *  mercmac.path that is a shell script running Python without exec leaves nothing
+   *  behind); false if it has ended. */
+  signal(signal, others = []) {
+    if (this.child.exitCode !== null || this.child.signalCode !== null || !this.child.pid) {
+      return false;
+    }
+    for (const pid of others) {
+      try {
+        process.kill(pid, signal);
+      } catch {
+        // gone
+      }
+    }
+    return this.child.kill(signal);
+  }
+
   /** End it if the shutdown request and exit notification did not (a server stuck, or one
    *  that never got them because the client was not running). */
   async stop(ms = 2000) {
@@ -132,4 +179,4 @@ class ServerProcess {
   }
 }
 
-module.exports = { ServerProcess, locate };
+module.exports = { ServerProcess, locate, descendants };

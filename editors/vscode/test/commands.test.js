@@ -43,14 +43,22 @@ test("package.json: Restricted Mode keeps highlighting, not the server", () => {
 
 test("the commands are declared and registered; copyBuild is not in the palette", async () => {
   const declared = pkg.contributes.commands.map((c) => c.command).sort();
-  assert.deepStrictEqual(declared,
-    ["mercmac.copyBuild", "mercmac.restartServer", "mercmac.showServerLog", "mercmac.showVersion"]);
+  assert.deepStrictEqual(declared, ["mercmac.copyBuild", "mercmac.restartServer", "mercmac.showServerLog",
+    "mercmac.showVersion", "mercmac.simulate"]);
   const titles = Object.fromEntries(pkg.contributes.commands.map((c) => [c.command, `${c.category}: ${c.title}`]));
   assert.strictEqual(titles["mercmac.restartServer"], "mercmac: Restart Server");
   assert.strictEqual(titles["mercmac.showServerLog"], "mercmac: Show Server Log");
   assert.strictEqual(titles["mercmac.showVersion"], "mercmac: Show Version");
-  assert.deepStrictEqual(pkg.contributes.menus.commandPalette,
-    [{ command: "mercmac.copyBuild", when: "false" }]);
+  assert.strictEqual(titles["mercmac.simulate"], "mercmac: Simulate");
+  const palette = pkg.contributes.menus.commandPalette;
+  assert.deepStrictEqual(palette.map((m) => m.command), ["mercmac.copyBuild", "mercmac.simulate"]);
+  assert.strictEqual(palette[0].when, "false");
+  // Simulate: in the palette for .mcm and rig files, and a button on their editors' title
+  for (const menu of [palette[1], ...pkg.contributes.menus["editor/title"]]) {
+    assert.strictEqual(menu.command, "mercmac.simulate");
+    assert.match(menu.when, /resourceExtname == \.mcm/);
+    assert.ok(menu.when.includes("resourceFilename =~ /\\.rig\\.toml$/"), menu.when);
+  }
   const { vscode } = await activated({ "mercmac.path": fakeMercmac().path });
   assert.deepStrictEqual((await vscode.commands.getCommands()).sort(), declared);
 });

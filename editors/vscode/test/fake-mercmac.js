@@ -1,7 +1,8 @@
 // A stand-in for `mercmac` (run through a shell wrapper, test/fakes.js), so that the client's
 // lifecycle is tested without Python: `--version` prints a version, `lsp --stdio` is a
 // language server that answers initialize, shutdown and exit, and FAKE_MERCMAC_MODE makes
-// it misbehave: "crash" exits (code 1, after "boom" on stderr) once initialized.
+// it misbehave: "crash" exits (code 1, after "boom" on stderr) once initialized; `sim FILE
+// --web` is test/fake-sim.js, and its modes are there.
 // `node --test test/` runs every .js file here as a test file: without arguments it does
 // nothing.
 "use strict";
@@ -51,6 +52,8 @@ if (args[0] === "--version") {
   process.stdout.write(`mercmac, version ${VERSION}\n`);
 } else if (args[0] === "lsp") {
   serve(process.env.FAKE_MERCMAC_MODE || "ok");
+} else if (args[0] === "sim") {
+  require("./fake-sim").simulate(args.slice(1), process.env.FAKE_MERCMAC_MODE || "ok");
 }
 
 module.exports = { VERSION };

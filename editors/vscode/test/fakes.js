@@ -29,6 +29,12 @@ function fakeMercmac(mode = "ok", dir = tempDir()) {
   return script(dir, `FAKE_MERCMAC_MODE=${mode} exec ${quote(process.execPath)} ${quote(FAKE)} "$@"`);
 }
 
+/** The fake run by a shell script that does not exec it: a child of the shell (as a
+ *  mercmac.path script that activates a venv, then runs mercmac, may be). */
+function shellWrappedMercmac(mode = "ok", dir = tempDir()) {
+  return script(dir, `FAKE_MERCMAC_MODE=${mode} ${quote(process.execPath)} ${quote(FAKE)} "$@"`);
+}
+
 /** mercmac installed without the lsp extra: `lsp` says so and exits 2 before reading anything. */
 function mercmacWithoutLsp(dir = tempDir()) {
   return script(dir, `if [ "$1" = --version ]; then echo 'mercmac, version 0.1.0'; exit 0; fi\necho ${quote(NO_LSP_EXTRA)} >&2\nexit 2`);
@@ -54,4 +60,4 @@ function realMercmac() {
   return undefined;
 }
 
-module.exports = { fakeMercmac, mercmacWithoutLsp, recordingMercmac, realMercmac, tempDir, NO_LSP_EXTRA };
+module.exports = { fakeMercmac, shellWrappedMercmac, mercmacWithoutLsp, recordingMercmac, realMercmac, tempDir, NO_LSP_EXTRA };

@@ -4,6 +4,7 @@
 // bundled in dist/extension.js): it spawns the server and speaks JSON-RPC to it.
 "use strict";
 const Module = require("node:module");
+const { fileURLToPath, pathToFileURL } = require("node:url");
 
 class EventEmitter {
   constructor() {
@@ -31,6 +32,53 @@ class Disposable {
   dispose() {
     if (this.callOnDispose) this.callOnDispose();
   }
+}
+
+/** vscode.Uri, for file: and untitled: URIs (what the simulate command is given). */
+class Uri {
+  constructor(scheme, fsPath, text) {
+    Object.assign(this, { scheme, fsPath, path: scheme === "file" ? pathToFileURL(fsPath).pathname : fsPath });
+    this.text = text || (scheme === "file" ? pathToFileURL(fsPath).href : `${scheme}:${fsPath}`);
+  }
+  static file(fsPath) {
+    return new Uri("file", fsPath);
+  }
+  static parse(text) {
+    if (text.startsWith("file:")) return new Uri("file", fileURLToPath(text));
+    const colon = text.indexOf(":");
+    return new Uri(text.slice(0, colon), text.slice(colon + 1), text);
+  }
+  toString() {
+    return this.text;
+  }
+}
+
+/** A webview panel as createWebviewPanel makes it: `posted` holds what the extension sent the
+ *  page; `send(message)` is the page posting MESSAGE; `dispose()` the person closing it. */
+function makePanel(viewType, title, showOptions, options) {
+  const received = new EventEmitter();
+  const disposed = new EventEmitter();
+  const panel = {
+    viewType, title, showOptions, options, revealed: 0, disposed: false, posted: [],
+    webview: {
+      html: "", cspSource: "https://fake.vscode-cdn.net", options,
+      postMessage: async (message) => {
+        if (panel.disposed) throw new Error("Webview is disposed");
+        panel.posted.push(message);
+        return true;
+      },
+      onDidReceiveMessage: received.event,
+    },
+    onDidDispose: disposed.event,
+    reveal() { panel.revealed += 1; },
+    dispose() {
+      if (panel.disposed) return;
+      panel.disposed = true;
+      disposed.fire();
+    },
+    send(message) { received.fire(message); },
+  };
+  return panel;
 }
 
 /** A callable, constructible value whose every member is another such value. */
@@ -63,12 +111,14 @@ function withInert(object, name) {
  * A fresh `vscode` with SETTINGS ({"mercmac.path": ...}); `seen` records what was shown:
  * errors (error and warning messages), infos, messages ({kind, text, items}), output (text
  * written to any channel), channels (every createOutputChannel), statusItems, executed
- * commands, the clipboard. OPTIONS: trusted (workspace trust, default true), answer(message,
- * items) picks the button a message gets (default: none).
+ * commands, the clipboard, panels (every createWebviewPanel, see makePanel), saved (the files
+ * workspace.fs.writeFile wrote). OPTIONS: trusted (workspace trust, default true),
+ * answer(message, items) picks the button a message gets (default: none), saveAs(options) the
+ * Uri the save dialog answers (default: none, cancelled).
  */
 function makeVscode(settings, options = {}) {
   const seen = { errors: [], infos: [], messages: [], output: [], channels: [], statusItems: [],
-                 executed: [], clipboard: undefined };
+                 executed: [], clipboard: undefined, panels: [], saved: [] };
   const configuration = new EventEmitter();
   const trust = new EventEmitter();
   const commands = new Map();
@@ -88,6 +138,8 @@ function makeVscode(settings, options = {}) {
            clipboard: { writeText: async (text) => (seen.clipboard = text), readText: async () => seen.clipboard } },
     EventEmitter,
     Disposable,
+    Uri,
+    ViewColumn: { Active: -1, Beside: -2, One: 1, Two: 2 },
     LanguageStatusSeverity: { Information: 0, Warning: 1, Error: 2 },
     workspace: {
       getConfiguration: (section) => ({
@@ -108,6 +160,12 @@ function makeVscode(settings, options = {}) {
       onDidSaveTextDocument: none,
       onWillSaveTextDocument: none,
       onDidChangeWorkspaceFolders: none,
+      fs: {
+        writeFile: async (uri, bytes) => {
+          require("node:fs").writeFileSync(uri.fsPath, bytes);
+          seen.saved.push(uri.fsPath);
+        },
+      },
     },
     window: {
       createOutputChannel: (name) => {
@@ -124,6 +182,14 @@ function makeVscode(settings, options = {}) {
       showErrorMessage: show("error", seen.errors),
       showWarningMessage: show("warning", seen.errors),
       showInformationMessage: show("info", seen.infos),
+      activeTextEditor: undefined,
+      createWebviewPanel: (...args) => {
+        const panel = makePanel(...args);
+        seen.panels.push(panel);
+        return panel;
+      },
+      showSaveDialog: async (saveOptions) => (options.saveAs ? options.saveAs(saveOptions) : undefined),
+      setStatusBarMessage: () => new Disposable(),
     },
     commands: {
       registerCommand: (id, handler) => {
