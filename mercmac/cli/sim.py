@@ -44,7 +44,7 @@ from mercmac.errors import EXIT_FAILED, EXIT_OK
 @click.option("--web", is_flag=True,
               help="The box and the stage in the browser: a local page (127.0.0.1, with a "
                    "token in its address) where buttons are held with the mouse, touch or "
-                   "keys 1-4; Ctrl-C stops it.")
+                   "keys 1-4; it follows the file as you save it. Ctrl-C stops it.")
 @click.option("--port", type=click.IntRange(0, 65535), default=0, metavar="N",
               help="With --web: the port (default: a free one).")
 @click.option("--no-open", "no_open", is_flag=True,

@@ -131,8 +131,11 @@ def code_lenses(ls: MercmacServer, params: t.CodeLensParams) -> list[t.CodeLens]
     if seen.rig:
         return []
     document: Document = ls.workspace.get_text_document(uri)
+
+    def at(line: int) -> t.Range:
+        return t.Range(document.position(line, 1), document.position(line, 1))
+
     # a lens with no lines to copy is a label: an empty command, which editors show unclickable
-    at = lambda line: t.Range(document.position(line, 1), document.position(line, 1))  # noqa: E731
     found = [t.CodeLens(range=at(lens.line),
                         command=t.Command(title=lens.title,
                                           command=lowered.COPY_BUILD if lens.lines else "",

@@ -94,7 +94,8 @@ class Live:
         self.hazard: dict[str, str] = {}  # each controller's last hazard since power-on
         for name, machine in sim.machines.items():
             machine.listeners.append(self._listener(name, unit(machine.model)))
-        self.axes = [sim.machines[name] for name in sim.rig.path_axes()]
+        self.path_axes = sim.rig.path_axes()
+        self.axes = [sim.machines[name] for name in self.path_axes]
         self.pressable = {name: [refusal(sim.rig, name, n) is None for n in BUTTONS]
                           for name in sim.machines}  # the wires say it, once per program
         for name, inputs in held.items():
@@ -253,7 +254,7 @@ class Live:
                     "wires": [{"from": str(w.source), "to": str(w.target),
                                "high": self.sim.machines[w.source.controller].outputs_pattern()
                                >> (w.source.number - 1) & 1 == 1} for w in self.sim.rig.wires],
-                    "path_axes": self.sim.rig.path_axes(), "path": path,
+                    "path_axes": self.path_axes, "path": path,
                     "log": [list(entry) for entry in log],
                     "problems": self.problems}, (seen_log, seen_path)
 

@@ -141,12 +141,13 @@ class _Handler(BaseHTTPRequestHandler):
             while not self.server.stopping.is_set():
                 live.advance()
                 state, seen = live.state(seen)
-                clock = state.pop("t_ms")
+                clock = state.pop("t_ms")  # compared apart: it alone changes while still
                 rest = json.dumps(state, separators=(",", ":"))
                 now = time.monotonic()
                 if (rest != last or state["log"] or state["path"]
                         or (clock != last_clock and now - sent >= STILL_S)):
-                    self.wfile.write(f'data: {{"t_ms":{clock},{rest[1:]}\n\n'.encode())
+                    data = json.dumps({"t_ms": clock, **state}, separators=(",", ":"))
+                    self.wfile.write(f"data: {data}\n\n".encode())
                     self.wfile.flush()
                     last, last_clock, sent = rest, clock, now
                 elif now - sent > BEAT_S:  # paused: a comment keeps the stream open

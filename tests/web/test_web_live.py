@@ -137,6 +137,8 @@ def test_the_process_follows_saves_and_keeps_the_last_good_program(tmp_path):
         path.write_text(good.replace("SV ", "SVX ", 1), encoding="utf-8")
         broken = _until(states, lambda s, log: s["problems"], "the problems")
         assert broken["t_ms"] >= first["t_ms"]  # the last good program kept running
+        _until(states, lambda s, log: s["problems"] and s["t_ms"] > broken["t_ms"] + 200,
+               "the last good program to run on")
         shown = _check_text(path)
         for problem in broken["problems"]:  # each as check words it, caret and all
             assert problem in shown, (problem, shown)

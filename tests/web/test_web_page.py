@@ -11,8 +11,10 @@ chromium`, which the fixture runs when it may).
 """
 from __future__ import annotations
 
+import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -34,17 +36,28 @@ FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
 def _chromium() -> str:
     """Debian's chromium; installed with apt-get when it is missing and root may."""
     found = shutil.which("chromium")
-    if found is None and shutil.which("apt-get") and hasattr(sys, "getuid") \
-            and __import__("os").getuid() == 0:
+    if found is None and shutil.which("apt-get") and hasattr(os, "getuid") and os.getuid() == 0:
         with held(lock_file(ROOT / "tests" / "web")):
             if shutil.which("chromium") is None:
-                subprocess.run(["apt-get", "install", "-y", "-q", "chromium"],
-                               capture_output=True, timeout=900, stdin=subprocess.DEVNULL)
+                _apt_install("chromium")
         found = shutil.which("chromium")
     if found is None:
         pytest.skip("chromium is not installed (apt-get install chromium): the page is not "
                     "tested in a browser")
     return found
+
+
+def _apt_install(package: str) -> None:
+    """apt-get install, and once more after apt-get update (a fresh machine has no package
+    lists), as the editor's e2e script does (editors/vscode/e2e/lib/tools.mjs)."""
+    env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
+    install = ["apt-get", "install", "-y", "-q", package]
+    if subprocess.run(install, capture_output=True, timeout=900, env=env,
+                      stdin=subprocess.DEVNULL).returncode != 0:
+        subprocess.run(["apt-get", "update", "-q"], capture_output=True, timeout=900, env=env,
+                       stdin=subprocess.DEVNULL)
+        subprocess.run(install, capture_output=True, timeout=900, env=env,
+                       stdin=subprocess.DEVNULL)
 
 
 @pytest.fixture
@@ -185,9 +198,6 @@ def test_a_hazard_is_marked_on_the_card_and_in_the_timeline(browser, serve, tmp_
 def test_a_save_with_an_error_is_shown_and_the_last_good_program_runs(browser, tmp_path):
     """`sim --web` as a process: the page lists the error of a saved change as `check` words
     it, goes on running, and drops the list when the file is fixed."""
-    import os
-    import signal
-
     path = tmp_path / "four-modes.mcm"
     good = EXAMPLE4.read_text(encoding="utf-8")
     path.write_text(good, encoding="utf-8")

@@ -13,23 +13,11 @@ const fs = require("node:fs");
 const http = require("node:http");
 const path = require("node:path");
 
-// what the page's files hold: enough for the webview's HTML to be checked, and texts that a
-// careless inlining would break (a closing script tag, replacement patterns)
-const INDEX = `<!doctype html>
-<html lang="en">
-<head>
-<meta charset="utf-8">
-<title>mercmac sim</title>
-<link rel="icon" href="data:,">
-<link rel="stylesheet" href="/static/style.css?token={{TOKEN}}">
-<script src="/static/app.js?token={{TOKEN}}" defer></script>
-</head>
-<body>
-<header class="topbar"><span id="conn">connecting</span></header>
-<main id="controllers"></main>
-</body>
-</html>
-`;
+// the page as mercmac ships it (its link and script tags are what the webview rewrites); an
+// app.js and a style.css with texts that a careless inlining would break (a closing script
+// tag, replacement patterns)
+const INDEX = fs.readFileSync(path.join(__dirname, "..", "..", "..", "mercmac", "web", "static",
+  "index.html"), "utf8");
 const APP_JS = `"use strict";
 // fake app.js: uses window.mercmacBridge; "$&" and "$'" and "</script>" must arrive as written
 window.fakeApp = { bridge: Boolean(window.mercmacBridge), text: "$& $' </script>" };
